@@ -1,0 +1,542 @@
+"""Compiled kernels: the one Newton-Euler recursion and the kinematics it needs.
+
+Everything here is scalar code over 3-tuples so that numba compiles it to
+tight machine code, and so that the very same source can run in plain
+Python on other number types (the high-precision reference evaluates this
+file with ``njit`` replaced by the identity).  Nothing here allocates in
+the hot path: callers pass a workspace array.
+
+Notation (all vectors of link j are expressed in link frame j):
+
+- ``R``, ``p``: rotation and origin of link frame j in frame j-1.
+- ``u``: unit joint axis of joint j; ``s``: vector from the point K where
+  the axis passes to the origin O_j (both fixed in link j); ``rK``: vector
+  from O_{j-1} to K in frame j-1.
+- ``w``: angular velocity (from qd); ``r``: the *reference* angular velocity
+  (from the second velocity argument ``v``); ``al``: angular acceleration;
+  ``ae``: acceleration of the point O_j; ``ac``: acceleration of the centre
+  of mass.  With ``v == qd`` these are the physical quantities of the
+  seed text and the recursion is its eqs. (19)-(21).
+
+Two velocity streams.  The recursion evaluates
+``Y(q, qd, v, qdd) = D(q) qdd + C(q, qd) v (+ g + J^T F_e)`` where C is the
+Christoffel-symbol Coriolis matrix.  Expanding the Lagrangian with body
+Jacobians J_i gives ``C v = sum_i J_i^T (M_i Jdot_i(qd) v + B_i(V_i) J_i v)``
+with ``B(V) = (M ad_V - ad_V^T M - K(M V)) / 2``, which is skew-symmetric
+(so Ddot - 2C is skew) and satisfies ``B(V) V = -ad_V^T M V`` (so C qd is
+the true velocity-product torque).  Written at the centre of mass in
+3-vectors this becomes the classical recursion with
+``w x (w x c)`` -> ``w x (r x c)``,
+``w_{j-1} x u qd_j`` -> ``r_{j-1} x u qd_j`` (revolute),
+``2 w x u qd_j`` -> ``(r x u) qd_j + (w x u) v_j`` (prismatic) and
+``w x I w`` -> ``(w x I r + r x I w + I (w x r)) / 2``.
+Every replacement reduces to the physical term exactly when ``v == qd``.
+
+The prismatic Coriolis term is ``2 w x u qd``: the seed's eqs. (15)-(18)
+keep only the ``zdot qd`` half and miss the half that comes from
+differentiating ``w x r`` while r grows at the rate ``u qd``.
+"""
+import math
+
+try:  # the high-precision reference injects its own (identity) decorator
+    njit = __njit_override__  # noqa: F821
+except NameError:
+    from numba import njit
+
+# Columns of the per-link parameter array ``links`` (one row per joint).
+L_TYPE = 0       # 0.0 revolute, 1.0 prismatic
+L_CONV = 1       # 0.0 standard DH, 1.0 modified DH
+L_A = 2
+L_CA = 3         # cos(alpha)
+L_SA = 4         # sin(alpha)
+L_D = 5          # d offset
+L_THETA = 6      # theta offset
+L_MASS = 7
+L_COM = 8        # 3 columns
+L_INERTIA = 11   # 9 columns, row-major, about the com in link-frame axes
+L_WIDTH = 20
+
+# Rows of the fixed-frame array ``frames`` (shape (3, 12)).
+F_BASE = 0       # R (9, row-major) then p (3): DH frame 0 in the base frame
+F_TOOL = 1       # end-effector frame in the last link frame
+F_GRAV = 2       # first 3 entries: gravity in frame-0 axes
+
+# Columns of the workspace ``ws`` (one row per joint).
+W_R = 0          # 9
+W_P = 9          # 3
+W_U = 12         # 3
+W_S = 15         # 3
+W_F = 18         # 3 net force on link j (m * a_c)
+W_N = 21         # 3 net moment about the com
+W_CT = 24        # cos(theta_j)
+W_ST = 25        # sin(theta_j)
+W_DD = 26        # d_j
+W_WIDTH = 27
+
+# Wrench modes.
+WRENCH_NONE = 0
+WRENCH_BASE = 1
+WRENCH_EE = 2
+
+
+@njit(cache=True)
+def _cross(a0, a1, a2, b0, b1, b2):
+    return (a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0)
+
+
+@njit(cache=True)
+def joint_trig(links, q, ws):
+    """Fill cos(theta_j), sin(theta_j), d_j of every joint into ``ws``."""
+    n = links.shape[0]
+    for j in range(n):
+        th = links[j, L_THETA]
+        dd = links[j, L_D]
+        if links[j, L_TYPE] == 0.0:
+            th = th + q[j]
+        else:
+            dd = dd + q[j]
+        ws[j, W_CT] = math.cos(th)
+        ws[j, W_ST] = math.sin(th)
+        ws[j, W_DD] = dd
+
+
+@njit(cache=True)
+def _link_geometry(links, j, ws):
+    """R, p, u, s and rK of joint j from the trig values in ``ws``."""
+    ct = ws[j, W_CT]
+    st = ws[j, W_ST]
+    d = ws[j, W_DD]
+    a = links[j, L_A]
+    ca = links[j, L_CA]
+    sa = links[j, L_SA]
+    zero = 0.0 * ct
+    if links[j, L_CONV] == 0.0:
+        # standard: A = Rz(theta) Tz(d) Tx(a) Rx(alpha); axis z_{j-1} through
+        # K = O_{j-1} + d z_{j-1}; O_j = K + a x_j.
+        R = (ct, -st * ca, st * sa, st, ct * ca, -ct * sa, zero, sa, ca)
+        p = (a * ct, a * st, d)
+        u = (zero, sa, ca)
+        s = (a, zero, zero)
+        rK = (zero, zero, d)
+    else:
+        # modified (Craig): A = Rx(alpha) Tx(a) Rz(theta) Tz(d); axis z_j
+        # through K = O_j.
+        R = (ct, -st, zero, ca * st, ca * ct, -sa, sa * st, sa * ct, ca)
+        p = (a, -sa * d, ca * d)
+        u = (zero, zero, 1.0 + zero)
+        s = (zero, zero, zero)
+        rK = p
+    return R, p, u, s, rK
+
+
+@njit(cache=True)
+def _rotT(R, x0, x1, x2):
+    """R^T x."""
+    return (R[0] * x0 + R[3] * x1 + R[6] * x2,
+            R[1] * x0 + R[4] * x1 + R[7] * x2,
+            R[2] * x0 + R[5] * x1 + R[8] * x2)
+
+
+@njit(cache=True)
+def _rot(R, x0, x1, x2):
+    """R x."""
+    return (R[0] * x0 + R[1] * x1 + R[2] * x2,
+            R[3] * x0 + R[4] * x1 + R[5] * x2,
+            R[6] * x0 + R[7] * x1 + R[8] * x2)
+
+
+@njit(cache=True)
+def _matmul(A, B):
+    return (A[0] * B[0] + A[1] * B[3] + A[2] * B[6],
+            A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
+            A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
+            A[3] * B[0] + A[4] * B[3] + A[5] * B[6],
+            A[3] * B[1] + A[4] * B[4] + A[5] * B[7],
+            A[3] * B[2] + A[4] * B[5] + A[5] * B[8],
+            A[6] * B[0] + A[7] * B[3] + A[8] * B[6],
+            A[6] * B[1] + A[7] * B[4] + A[8] * B[7],
+            A[6] * B[2] + A[7] * B[5] + A[8] * B[8])
+
+
+@njit(cache=True)
+def _frame_rot(frames, row):
+    f = frames[row]
+    return (f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8])
+
+
+@njit(cache=True)
+def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
+              wrench_mode, ws, tau):
+    """Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
+
+    ``joint_trig(links, q, ws)`` must have been called for the same q.
+
+    Parameters
+    ----------
+    qd, v, qdd : (n,) joint velocity, reference velocity, acceleration.
+    wrench : (6,) [f; n] exerted by the end effector on its environment,
+        moment about the end-effector origin; base-frame axes when
+        ``wrench_mode == WRENCH_BASE``, end-effector axes when
+        ``WRENCH_EE``; ignored when ``WRENCH_NONE``.
+    gravity_on, velocity_on : skip the gravity or velocity-product terms
+        altogether when False.
+    tau : (n,) output.
+
+    Cost: about 330 flops per joint, O(n).
+    """
+    n = links.shape[0]
+    zero = 0.0 * ws[0, W_CT]
+    # Gravity enters as an upward acceleration of the base: a_0 = -g.
+    if gravity_on:
+        ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    else:
+        ae = (zero, zero, zero)
+    w = (zero, zero, zero)
+    r = (zero, zero, zero)
+    al = (zero, zero, zero)
+    Racc = _frame_rot(frames, F_BASE)
+
+    # ---- forward recursion: base to tip ----
+    for j in range(n):
+        R, p, u, s, rK = _link_geometry(links, j, ws)
+        # acceleration of the point K, still in frame j-1 axes
+        t = _cross(al[0], al[1], al[2], rK[0], rK[1], rK[2])
+        aK = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        if velocity_on:
+            t = _cross(r[0], r[1], r[2], rK[0], rK[1], rK[2])
+            t = _cross(w[0], w[1], w[2], t[0], t[1], t[2])
+            aK = (aK[0] + t[0], aK[1] + t[1], aK[2] + t[2])
+        # rotate everything into frame j
+        aK = _rotT(R, aK[0], aK[1], aK[2])
+        al = _rotT(R, al[0], al[1], al[2])
+        revolute = links[j, L_TYPE] == 0.0
+        if velocity_on:
+            w = _rotT(R, w[0], w[1], w[2])
+            r = _rotT(R, r[0], r[1], r[2])
+            if revolute:
+                # alpha_j = R^T alpha_{j-1} + u qdd + (r_{j-1} x u) qd_j
+                t = _cross(r[0], r[1], r[2], u[0], u[1], u[2])
+                al = (al[0] + u[0] * qdd[j] + t[0] * qd[j],
+                      al[1] + u[1] * qdd[j] + t[1] * qd[j],
+                      al[2] + u[2] * qdd[j] + t[2] * qd[j])
+                w = (w[0] + u[0] * qd[j], w[1] + u[1] * qd[j],
+                     w[2] + u[2] * qd[j])
+                r = (r[0] + u[0] * v[j], r[1] + u[1] * v[j],
+                     r[2] + u[2] * v[j])
+        elif revolute:
+            al = (al[0] + u[0] * qdd[j], al[1] + u[1] * qdd[j],
+                  al[2] + u[2] * qdd[j])
+        # acceleration of O_j: from K along s, with the joint's own terms
+        t = _cross(al[0], al[1], al[2], s[0], s[1], s[2])
+        ae = (aK[0] + t[0], aK[1] + t[1], aK[2] + t[2])
+        if velocity_on:
+            t = _cross(r[0], r[1], r[2], s[0], s[1], s[2])
+            t = _cross(w[0], w[1], w[2], t[0], t[1], t[2])
+            ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        if not revolute:
+            ae = (ae[0] + u[0] * qdd[j], ae[1] + u[1] * qdd[j],
+                  ae[2] + u[2] * qdd[j])
+            if velocity_on:
+                # Coriolis of the sliding joint: 2 w x u qd when v == qd
+                t = _cross(r[0], r[1], r[2], u[0], u[1], u[2])
+                t2 = _cross(w[0], w[1], w[2], u[0], u[1], u[2])
+                ae = (ae[0] + t[0] * qd[j] + t2[0] * v[j],
+                      ae[1] + t[1] * qd[j] + t2[1] * v[j],
+                      ae[2] + t[2] * qd[j] + t2[2] * v[j])
+        # acceleration of the centre of mass
+        c0 = links[j, L_COM]
+        c1 = links[j, L_COM + 1]
+        c2 = links[j, L_COM + 2]
+        t = _cross(al[0], al[1], al[2], c0, c1, c2)
+        ac = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        if velocity_on:
+            t = _cross(r[0], r[1], r[2], c0, c1, c2)
+            t = _cross(w[0], w[1], w[2], t[0], t[1], t[2])
+            ac = (ac[0] + t[0], ac[1] + t[1], ac[2] + t[2])
+        m = links[j, L_MASS]
+        ws[j, W_F] = m * ac[0]
+        ws[j, W_F + 1] = m * ac[1]
+        ws[j, W_F + 2] = m * ac[2]
+        # Euler's equation about the com
+        I = L_INERTIA
+        Ia = _rot((links[j, I], links[j, I + 1], links[j, I + 2],
+                   links[j, I + 3], links[j, I + 4], links[j, I + 5],
+                   links[j, I + 6], links[j, I + 7], links[j, I + 8]),
+                  al[0], al[1], al[2])
+        Nn = Ia
+        if velocity_on:
+            Ic = (links[j, I], links[j, I + 1], links[j, I + 2],
+                  links[j, I + 3], links[j, I + 4], links[j, I + 5],
+                  links[j, I + 6], links[j, I + 7], links[j, I + 8])
+            Ir = _rot(Ic, r[0], r[1], r[2])
+            Iw = _rot(Ic, w[0], w[1], w[2])
+            t = _cross(w[0], w[1], w[2], Ir[0], Ir[1], Ir[2])
+            t2 = _cross(r[0], r[1], r[2], Iw[0], Iw[1], Iw[2])
+            wr = _cross(w[0], w[1], w[2], r[0], r[1], r[2])
+            t3 = _rot(Ic, wr[0], wr[1], wr[2])
+            Nn = (Ia[0] + 0.5 * ((t[0] + t2[0]) + t3[0]),
+                  Ia[1] + 0.5 * ((t[1] + t2[1]) + t3[1]),
+                  Ia[2] + 0.5 * ((t[2] + t2[2]) + t3[2]))
+        ws[j, W_N] = Nn[0]
+        ws[j, W_N + 1] = Nn[1]
+        ws[j, W_N + 2] = Nn[2]
+        for k in range(9):
+            ws[j, W_R + k] = R[k]
+        for k in range(3):
+            ws[j, W_P + k] = p[k]
+            ws[j, W_U + k] = u[k]
+            ws[j, W_S + k] = s[k]
+        if wrench_mode == WRENCH_BASE:
+            Racc = _matmul(Racc, R)
+
+    # ---- the wrench the tip exerts, as "f_{n+1}, tau_{n+1}" in frame n ----
+    f = (zero, zero, zero)
+    nm = (zero, zero, zero)
+    if wrench_mode != WRENCH_NONE:
+        Rt = _frame_rot(frames, F_TOOL)
+        fe = (wrench[0], wrench[1], wrench[2])
+        ne = (wrench[3], wrench[4], wrench[5])
+        if wrench_mode == WRENCH_BASE:
+            Ree = _matmul(Racc, Rt)
+            fe = _rotT(Ree, fe[0], fe[1], fe[2])
+            ne = _rotT(Ree, ne[0], ne[1], ne[2])
+        f = _rot(Rt, fe[0], fe[1], fe[2])
+        nm = _rot(Rt, ne[0], ne[1], ne[2])
+        t = _cross(frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11],
+                   f[0], f[1], f[2])
+        nm = (nm[0] + t[0], nm[1] + t[1], nm[2] + t[2])
+
+    # ---- backward recursion: tip to base ----
+    # f, nm hold the force and the moment (about O_j) that link j exerts on
+    # its child, in frame j axes.
+    for j in range(n - 1, -1, -1):
+        F0 = ws[j, W_F]
+        F1 = ws[j, W_F + 1]
+        F2 = ws[j, W_F + 2]
+        t = _cross(links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2],
+                   F0, F1, F2)
+        nm = (nm[0] + t[0] + ws[j, W_N], nm[1] + t[1] + ws[j, W_N + 1],
+              nm[2] + t[2] + ws[j, W_N + 2])
+        f = (f[0] + F0, f[1] + F1, f[2] + F2)
+        u0 = ws[j, W_U]
+        u1 = ws[j, W_U + 1]
+        u2 = ws[j, W_U + 2]
+        if links[j, L_TYPE] == 0.0:
+            # moment about the axis point K = O_j - s
+            t = _cross(ws[j, W_S], ws[j, W_S + 1], ws[j, W_S + 2],
+                       f[0], f[1], f[2])
+            tau[j] = (u0 * (nm[0] + t[0]) + u1 * (nm[1] + t[1])
+                      + u2 * (nm[2] + t[2]))
+        else:
+            tau[j] = u0 * f[0] + u1 * f[1] + u2 * f[2]
+        if j > 0:
+            R = (ws[j, W_R], ws[j, W_R + 1], ws[j, W_R + 2],
+                 ws[j, W_R + 3], ws[j, W_R + 4], ws[j, W_R + 5],
+                 ws[j, W_R + 6], ws[j, W_R + 7], ws[j, W_R + 8])
+            f = _rot(R, f[0], f[1], f[2])
+            nm = _rot(R, nm[0], nm[1], nm[2])
+            t = _cross(ws[j, W_P], ws[j, W_P + 1], ws[j, W_P + 2],
+                       f[0], f[1], f[2])
+            nm = (nm[0] + t[0], nm[1] + t[1], nm[2] + t[2])
+
+
+@njit(cache=True)
+def first_nonfinite(x):
+    """Index of the first non-finite entry of x, or -1."""
+    for i in range(x.shape[0]):
+        if not math.isfinite(x[i]):
+            return i
+    return -1
+
+
+@njit(cache=True)
+def check_finite(q, qd, qdd, wrench):
+    """-1 when all entries are finite, else 1000 * argument + index."""
+    i = first_nonfinite(q)
+    if i >= 0:
+        return i
+    i = first_nonfinite(qd)
+    if i >= 0:
+        return 1000 + i
+    i = first_nonfinite(qdd)
+    if i >= 0:
+        return 2000 + i
+    i = first_nonfinite(wrench)
+    if i >= 0:
+        return 3000 + i
+    return -1
+
+
+@njit(cache=True)
+def inverse_dynamics(links, frames, q, qd, qdd, wrench, gravity_on,
+                     velocity_on, wrench_mode, ws, tau):
+    """tau(q, qd, qdd, F_e) after checking the inputs are finite.
+
+    Returns -1, or the code of the first non-finite input (see
+    ``check_finite``); tau is untouched then.
+    """
+    bad = check_finite(q, qd, qdd, wrench)
+    if bad >= 0:
+        return bad
+    joint_trig(links, q, ws)
+    recursion(links, frames, qd, qd, qdd, wrench, gravity_on, velocity_on,
+              wrench_mode, ws, tau)
+    return -1
+
+
+@njit(cache=True)
+def inverse_dynamics_batch(links, frames, Q, QD, QDD, W, gravity_on,
+                           velocity_on, wrench_mode, ws, TAU):
+    """Row-by-row inverse dynamics over a batch of states."""
+    for k in range(Q.shape[0]):
+        joint_trig(links, Q[k], ws)
+        recursion(links, frames, QD[k], QD[k], QDD[k], W[k], gravity_on,
+                  velocity_on, wrench_mode, ws, TAU[k])
+
+
+@njit(cache=True)
+def mass_matrix(links, frames, q, ws, scratch, D):
+    """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k).
+
+    ``scratch`` is a (3, n) array.  Cost: n recursions, O(n^2).
+    """
+    n = links.shape[0]
+    joint_trig(links, q, ws)
+    zero = scratch[0]
+    unit = scratch[1]
+    col = scratch[2]
+    for i in range(n):
+        zero[i] = 0.0
+        unit[i] = 0.0
+    for k in range(n):
+        unit[k] = 1.0
+        recursion(links, frames, zero, zero, unit, zero, False, False,
+                  WRENCH_NONE, ws, col)
+        unit[k] = 0.0
+        for i in range(n):
+            D[i, k] = col[i]
+    # D is symmetric in exact arithmetic; make it so to the last bit.
+    for i in range(n):
+        for k in range(i + 1, n):
+            avg = 0.5 * (D[i, k] + D[k, i])
+            D[i, k] = avg
+            D[k, i] = avg
+
+
+@njit(cache=True)
+def coriolis_matrix(links, frames, q, qd, ws, scratch, C):
+    """Christoffel C(q, qd) column by column: C e_k = Y(q, qd, e_k, 0)."""
+    n = links.shape[0]
+    joint_trig(links, q, ws)
+    zero = scratch[0]
+    unit = scratch[1]
+    col = scratch[2]
+    for i in range(n):
+        zero[i] = 0.0
+        unit[i] = 0.0
+    for k in range(n):
+        unit[k] = 1.0
+        recursion(links, frames, qd, unit, zero, zero, False, True,
+                  WRENCH_NONE, ws, col)
+        unit[k] = 0.0
+        for i in range(n):
+            C[i, k] = col[i]
+
+
+@njit(cache=True)
+def forward_kinematics(links, frames, q, ws, Ts):
+    """Poses of frames 0..n and of the end effector in the base frame.
+
+    ``Ts`` is (n + 2, 12): rows 0..n the link frames, row n+1 the end
+    effector; each row R (9, row-major) then p (3).
+    """
+    n = links.shape[0]
+    joint_trig(links, q, ws)
+    Rw = _frame_rot(frames, F_BASE)
+    pw = (frames[F_BASE, 9], frames[F_BASE, 10], frames[F_BASE, 11])
+    for k in range(9):
+        Ts[0, k] = Rw[k]
+    for k in range(3):
+        Ts[0, 9 + k] = pw[k]
+    for j in range(n + 1):
+        if j < n:
+            R, p, u, s, rK = _link_geometry(links, j, ws)
+        else:
+            R = _frame_rot(frames, F_TOOL)
+            p = (frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11])
+        t = _rot(Rw, p[0], p[1], p[2])
+        pw = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
+        Rw = _matmul(Rw, R)
+        for k in range(9):
+            Ts[j + 1, k] = Rw[k]
+        for k in range(3):
+            Ts[j + 1, 9 + k] = pw[k]
+
+
+@njit(cache=True)
+def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
+    """Geometric Jacobian of the end-effector origin, rows [v; w].
+
+    Base-frame axes, or end-effector axes when ``in_ee_axes``.  Cost O(n).
+    """
+    n = links.shape[0]
+    forward_kinematics(links, frames, q, ws, Ts)
+    pe = (Ts[n + 1, 9], Ts[n + 1, 10], Ts[n + 1, 11])
+    for j in range(n):
+        # the axis of joint j and a point K on it, in base axes
+        if links[j, L_CONV] == 0.0:
+            row = j           # standard: z_{j-1} through O_{j-1} + d z_{j-1}
+        else:
+            row = j + 1       # modified: z_j through O_j
+        Rr = (Ts[row, 0], Ts[row, 1], Ts[row, 2], Ts[row, 3], Ts[row, 4],
+              Ts[row, 5], Ts[row, 6], Ts[row, 7], Ts[row, 8])
+        z = (Rr[2], Rr[5], Rr[8])
+        if links[j, L_TYPE] == 0.0:
+            rel = (pe[0] - Ts[row, 9], pe[1] - Ts[row, 10],
+                   pe[2] - Ts[row, 11])
+            lin = _cross(z[0], z[1], z[2], rel[0], rel[1], rel[2])
+            ang = z
+        else:
+            lin = z
+            ang = (0.0, 0.0, 0.0)
+        if in_ee_axes:
+            Re = (Ts[n + 1, 0], Ts[n + 1, 1], Ts[n + 1, 2], Ts[n + 1, 3],
+                  Ts[n + 1, 4], Ts[n + 1, 5], Ts[n + 1, 6], Ts[n + 1, 7],
+                  Ts[n + 1, 8])
+            lin = _rotT(Re, lin[0], lin[1], lin[2])
+            ang = _rotT(Re, ang[0], ang[1], ang[2])
+        for k in range(3):
+            J[k, j] = lin[k]
+            J[3 + k, j] = ang[k]
+
+
+@njit(cache=True)
+def cholesky_solve(A, b, L, x):
+    """Solve A x = b for symmetric positive definite A by Cholesky.
+
+    Returns -1 on success, or the index of the first pivot that is not
+    positive (A is not positive definite there).  A is left unchanged.
+    """
+    n = A.shape[0]
+    for i in range(n):
+        for k in range(i + 1):
+            acc = A[i, k]
+            for m in range(k):
+                acc -= L[i, m] * L[k, m]
+            if i == k:
+                if not acc > 0.0:
+                    return i
+                L[i, i] = math.sqrt(acc)
+            else:
+                L[i, k] = acc / L[k, k]
+    for i in range(n):
+        acc = b[i]
+        for m in range(i):
+            acc -= L[i, m] * x[m]
+        x[i] = acc / L[i, i]
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for m in range(i + 1, n):
+            acc -= L[m, i] * x[m]
+        x[i] = acc / L[i, i]
+    return -1

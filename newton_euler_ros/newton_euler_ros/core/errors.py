@@ -1,0 +1,35 @@
+"""Exception types of the core library."""
+
+
+class NewtonEulerError(Exception):
+    """Base class of every error this package raises on purpose."""
+
+
+class RobotFileError(NewtonEulerError, ValueError):
+    """A robot (or scene) description is invalid.
+
+    The message names the file, the link and the field, e.g.
+    ``puma560.yaml: links[2] (joint3): mass: must be >= 0, got -1.0``.
+    """
+
+
+class DynamicsInputError(NewtonEulerError, ValueError):
+    """A state or wrench passed to a dynamics function is unusable.
+
+    Raised for a wrong size or a non-finite entry; the message names the
+    argument and the index, e.g. ``qd[3] is nan; every entry must be
+    finite``.
+    """
+
+
+class NotPositiveDefiniteError(NewtonEulerError, ArithmeticError):
+    """The mass matrix is not positive definite, so it cannot be inverted.
+
+    ``joint`` is the index of the first joint whose Cholesky pivot is not
+    positive: that joint, given the joints before it, moves no mass or
+    inertia (for example a massless tail of the chain).
+    """
+
+    def __init__(self, message, joint):
+        super().__init__(message)
+        self.joint = joint

@@ -1,0 +1,172 @@
+"""The constant robot model: a serial chain in Denavit-Hartenberg form.
+
+A :class:`RobotModel` is immutable after construction (its arrays are
+read-only).  Per-call scratch memory lives in a separate
+:class:`~newton_euler_ros.core.dynamics.Workspace`.
+
+Frames and conventions (SI units throughout):
+
+- *base frame*: the frame the robot is mounted in (``base_link`` in ROS).
+  Gravity, wrenches in base axes and the Jacobian are expressed here.
+- *frame 0*: the first DH frame, at pose ``base`` in the base frame.
+- *link frame j* (j = 1..n): standard DH puts it at the distal end of link
+  j, and joint j moves about z_{j-1}; modified (Craig) DH puts it at joint
+  j, and joint j moves about z_j.
+- *end-effector frame*: at pose ``tool`` in link frame n.
+"""
+from dataclasses import dataclass, field
+import math
+
+import numpy as np
+
+from . import _kernels as K
+
+REVOLUTE = 'revolute'
+PRISMATIC = 'prismatic'
+STANDARD = 'standard'
+MODIFIED = 'modified'
+
+
+def rpy_matrix(roll, pitch, yaw):
+    """Rotation of ROS roll-pitch-yaw angles: Rz(yaw) Ry(pitch) Rx(roll)."""
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr]])
+
+
+def pose_matrix(xyz=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0)):
+    """4x4 homogeneous transform from a translation and ROS rpy angles."""
+    T = np.eye(4)
+    T[:3, :3] = rpy_matrix(*rpy)
+    T[:3, 3] = xyz
+    return T
+
+
+def _readonly(x):
+    x = np.array(x, dtype=np.float64)
+    x.setflags(write=False)
+    return x
+
+
+@dataclass(frozen=True, eq=False)
+class RobotModel:
+    """A serial manipulator: DH table, inertial parameters, gravity, frames.
+
+    Build one with :func:`make_model` or
+    :func:`newton_euler_ros.core.robot_file.load_robot`.
+
+    Attributes
+    ----------
+    name : str
+    convention : ``'standard'`` or ``'modified'``
+    joint_names : tuple of n str
+    joint_types : tuple of n ``'revolute'`` / ``'prismatic'``
+    a, alpha, d, theta : (n,) DH parameters (m, rad, m, rad); the joint
+        variable adds to ``theta`` (revolute) or ``d`` (prismatic).
+    mass : (n,) kg
+    com : (n, 3) centre of mass in link frame j, m
+    inertia : (n, 3, 3) about the centre of mass, link-frame axes, kg m^2
+    gravity : (3,) gravitational acceleration in the base frame, m/s^2
+    base : (4, 4) pose of frame 0 in the base frame
+    tool : (4, 4) pose of the end-effector frame in link frame n
+    limits : tuple of n dicts (keys among lower, upper, velocity, effort)
+    links_array, frames_array : packed, read-only copies for the kernels
+    """
+
+    name: str
+    convention: str
+    joint_names: tuple
+    joint_types: tuple
+    a: np.ndarray
+    alpha: np.ndarray
+    d: np.ndarray
+    theta: np.ndarray
+    mass: np.ndarray
+    com: np.ndarray
+    inertia: np.ndarray
+    gravity: np.ndarray
+    base: np.ndarray
+    tool: np.ndarray
+    limits: tuple = ()
+    links_array: np.ndarray = field(init=False, repr=False)
+    frames_array: np.ndarray = field(init=False, repr=False)
+
+    def __post_init__(self):
+        n = len(self.joint_names)
+        links = np.zeros((n, K.L_WIDTH))
+        for j in range(n):
+            links[j, K.L_TYPE] = 0.0 if self.joint_types[j] == REVOLUTE else 1.0
+            links[j, K.L_CONV] = 0.0 if self.convention == STANDARD else 1.0
+            links[j, K.L_A] = self.a[j]
+            links[j, K.L_CA] = math.cos(self.alpha[j])
+            links[j, K.L_SA] = math.sin(self.alpha[j])
+            links[j, K.L_D] = self.d[j]
+            links[j, K.L_THETA] = self.theta[j]
+            links[j, K.L_MASS] = self.mass[j]
+            links[j, K.L_COM:K.L_COM + 3] = self.com[j]
+            links[j, K.L_INERTIA:K.L_INERTIA + 9] = self.inertia[j].ravel()
+        frames = np.zeros((3, 12))
+        for row, T in ((K.F_BASE, self.base), (K.F_TOOL, self.tool)):
+            frames[row, :9] = T[:3, :3].ravel()
+            frames[row, 9:] = T[:3, 3]
+        frames[K.F_GRAV, :3] = self.base[:3, :3].T @ self.gravity
+        object.__setattr__(self, 'links_array', _readonly(links))
+        object.__setattr__(self, 'frames_array', _readonly(frames))
+
+    @property
+    def n(self):
+        """Number of joints (degrees of freedom)."""
+        return len(self.joint_names)
+
+    @property
+    def total_mass(self):
+        """Sum of the link masses, kg."""
+        return float(self.mass.sum())
+
+    def replace(self, **changes):
+        """A copy with some fields changed (e.g. ``gravity=[0, 0, 0]``)."""
+        fields = {k: getattr(self, k) for k in (
+            'name', 'convention', 'joint_names', 'joint_types', 'a', 'alpha',
+            'd', 'theta', 'mass', 'com', 'inertia', 'gravity', 'base',
+            'tool', 'limits')}
+        fields.update(changes)
+        return make_model(**fields)
+
+
+def make_model(name, convention, joint_names, joint_types, a, alpha, d,
+               theta, mass, com, inertia, gravity=(0.0, 0.0, -9.81),
+               base=None, tool=None, limits=None):
+    """Build a :class:`RobotModel` from plain sequences (no validation of
+    physical plausibility; :func:`load_robot` does that for files)."""
+    n = len(joint_names)
+    if convention not in (STANDARD, MODIFIED):
+        raise ValueError(f"convention must be 'standard' or 'modified', "
+                         f"got {convention!r}")
+    for t in joint_types:
+        if t not in (REVOLUTE, PRISMATIC):
+            raise ValueError(f"joint type must be 'revolute' or 'prismatic', "
+                             f"got {t!r}")
+    return RobotModel(
+        name=str(name), convention=convention,
+        joint_names=tuple(str(x) for x in joint_names),
+        joint_types=tuple(str(t) for t in joint_types),
+        a=_readonly(np.reshape(a, n)), alpha=_readonly(np.reshape(alpha, n)),
+        d=_readonly(np.reshape(d, n)), theta=_readonly(np.reshape(theta, n)),
+        mass=_readonly(np.reshape(mass, n)),
+        com=_readonly(np.reshape(com, (n, 3))),
+        inertia=_readonly(np.reshape(inertia, (n, 3, 3))),
+        gravity=_readonly(np.reshape(gravity, 3)),
+        base=_readonly(np.eye(4) if base is None else base),
+        tool=_readonly(np.eye(4) if tool is None else tool),
+        limits=tuple(limits) if limits is not None else tuple({} for _ in
+                                                             range(n)))
+
+
+def inertia_matrix(ixx, iyy, izz, ixy, iyz, ixz):
+    """Symmetric 3x3 inertia from [Ixx, Iyy, Izz, Ixy, Iyz, Ixz]."""
+    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]],
+                    dtype=np.float64)

@@ -1,0 +1,312 @@
+"""Robot description files (YAML): loading, validation, bundled robots.
+
+The format is documented in the README ("Robot files").  Every error is a
+:class:`RobotFileError` whose message names the file, the link and the
+field.  Numbers may be written as YAML numbers, as strings that parse as
+numbers (PyYAML reads ``1e-5`` without a dot as a string) or as simple
+expressions of ``pi`` such as ``-pi/2`` or ``3*pi/4``.
+"""
+import ast
+import math
+import operator
+import os
+import sys
+import warnings
+
+import numpy as np
+import yaml
+
+from .errors import RobotFileError
+from .model import (MODIFIED, PRISMATIC, REVOLUTE, STANDARD, inertia_matrix,
+                    make_model, pose_matrix)
+
+TOP_KEYS = {'name', 'description', 'source', 'convention', 'gravity', 'base',
+            'tool', 'links'}
+LINK_KEYS = {'name', 'description', 'type', 'a', 'alpha', 'd', 'theta',
+             'mass', 'com', 'inertia', 'limits'}
+LINK_REQUIRED = ('name', 'type', 'a', 'alpha', 'd', 'mass', 'com', 'inertia')
+LIMIT_KEYS = {'lower', 'upper', 'velocity', 'effort'}
+POSE_KEYS = {'xyz', 'rpy'}
+
+
+class RobotFileWarning(UserWarning):
+    """A robot file is accepted but something in it is suspicious."""
+
+
+def bundled_dirs():
+    """Folders searched for bundled robot files, in order."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    return [
+        os.path.normpath(os.path.join(here, '..', '..', 'config', 'robots')),
+        os.path.join(sys.prefix, 'share', 'newton_euler_ros', 'config',
+                     'robots'),
+    ]
+
+
+def bundled_robots():
+    """Names of the bundled robots (file names without ``.yaml``)."""
+    names = set()
+    for folder in bundled_dirs():
+        if os.path.isdir(folder):
+            names.update(f[:-5] for f in os.listdir(folder)
+                         if f.endswith('.yaml'))
+    return sorted(names)
+
+
+def resolve_robot_path(name_or_path):
+    """A path to an existing file, or a bundled robot's name -> its path."""
+    path = os.fspath(name_or_path)
+    if os.path.isfile(path):
+        return path
+    if os.sep not in path and not path.endswith(('.yaml', '.yml')):
+        for folder in bundled_dirs():
+            candidate = os.path.join(folder, path + '.yaml')
+            if os.path.isfile(candidate):
+                return candidate
+    raise RobotFileError(
+        f'{path}: no such file, and not a bundled robot '
+        f'(bundled: {", ".join(bundled_robots()) or "none found"})')
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """SafeLoader that rejects a key given twice in one mapping."""
+
+
+def _construct_mapping(loader, node, deep=False):
+    seen = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None, None, f'key {key!r} appears twice',
+                key_node.start_mark)
+        seen.add(key)
+    return loader.construct_mapping(node, deep)
+
+
+_UniqueKeyLoader.add_constructor(
+    yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def read_yaml(path):
+    """Parse a YAML file, with errors that name the file and the line."""
+    try:
+        with open(path, encoding='utf-8') as fh:
+            return yaml.load(fh, Loader=_UniqueKeyLoader)
+    except OSError as exc:
+        raise RobotFileError(f'{path}: cannot read: {exc.strerror}') from None
+    except yaml.YAMLError as exc:
+        where = ''
+        mark = getattr(exc, 'problem_mark', None)
+        if mark is not None:
+            where = f' (line {mark.line + 1}, column {mark.column + 1})'
+        problem = getattr(exc, 'problem', None) or str(exc)
+        raise RobotFileError(f'{path}: not valid YAML{where}: {problem}') \
+            from None
+
+
+_OPS = {ast.Add: operator.add, ast.Sub: operator.sub,
+        ast.Mult: operator.mul, ast.Div: operator.truediv}
+
+
+def _eval_expr(node):
+    if isinstance(node, ast.Expression):
+        return _eval_expr(node.body)
+    if isinstance(node, ast.Constant) and type(node.value) in (int, float):
+        return float(node.value)
+    if isinstance(node, ast.Name) and node.id == 'pi':
+        return math.pi
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, (ast.USub,
+                                                              ast.UAdd)):
+        value = _eval_expr(node.operand)
+        return -value if isinstance(node.op, ast.USub) else value
+    if isinstance(node, ast.BinOp) and type(node.op) in _OPS:
+        return _OPS[type(node.op)](_eval_expr(node.left),
+                                   _eval_expr(node.right))
+    raise ValueError('not a number')
+
+
+def to_number(value, where):
+    """A finite float from a YAML value, or a RobotFileError naming where."""
+    if isinstance(value, bool) or value is None:
+        raise RobotFileError(f'{where}: must be a number, got {value!r}')
+    if isinstance(value, (int, float)):
+        result = float(value)
+    elif isinstance(value, str):
+        text = value.strip()
+        try:
+            result = float(text)
+        except ValueError:
+            try:
+                result = _eval_expr(ast.parse(text, mode='eval'))
+            except (SyntaxError, ValueError, ZeroDivisionError,
+                    RecursionError):
+                raise RobotFileError(
+                    f'{where}: must be a number (or an expression of pi '
+                    f'like "-pi/2"), got {value!r}') from None
+    else:
+        raise RobotFileError(
+            f'{where}: must be a number, got {type(value).__name__} '
+            f'{value!r}')
+    if not math.isfinite(result):
+        raise RobotFileError(f'{where}: must be finite, got {value!r}')
+    return result
+
+
+def to_vector(value, size, where):
+    """A list of ``size`` finite floats."""
+    if not isinstance(value, (list, tuple)):
+        raise RobotFileError(
+            f'{where}: must be a list of {size} numbers, got {value!r}')
+    if len(value) != size:
+        raise RobotFileError(
+            f'{where}: must have {size} entries, got {len(value)}')
+    return [to_number(x, f'{where}[{i}]') for i, x in enumerate(value)]
+
+
+def _check_keys(data, allowed, where):
+    if not isinstance(data, dict):
+        raise RobotFileError(f'{where}: must be a mapping, got {data!r}')
+    unknown = sorted(set(map(str, data)) - allowed)
+    if unknown:
+        raise RobotFileError(
+            f'{where}: unknown key {unknown[0]!r} '
+            f'(allowed: {", ".join(sorted(allowed))})')
+
+
+def _pose(data, where):
+    _check_keys(data, POSE_KEYS, where)
+    xyz = to_vector(data.get('xyz', [0.0, 0.0, 0.0]), 3, f'{where}.xyz')
+    rpy = to_vector(data.get('rpy', [0.0, 0.0, 0.0]), 3, f'{where}.rpy')
+    return pose_matrix(xyz, rpy)
+
+
+def _inertia(value, where):
+    if isinstance(value, (list, tuple)) and len(value) == 3 and all(
+            isinstance(r, (list, tuple)) for r in value):
+        rows = [to_vector(r, 3, f'{where}[{i}]') for i, r in enumerate(value)]
+        I = np.array(rows)
+        scale = max(np.abs(I).max(), 1e-300)
+        if np.abs(I - I.T).max() > 1e-12 * scale:
+            raise RobotFileError(f'{where}: must be symmetric, got {rows}')
+        I = 0.5 * (I + I.T)
+    else:
+        I = inertia_matrix(*to_vector(value, 6, where))
+    eig = np.linalg.eigvalsh(I)
+    scale = max(np.abs(I).max(), 1e-300)
+    if eig[0] < -1e-12 * scale:
+        raise RobotFileError(
+            f'{where}: must be positive semidefinite (principal moments '
+            f'{", ".join(f"{e:.6g}" for e in eig)})')
+    return I, eig
+
+
+def _limits(data, where):
+    _check_keys(data, LIMIT_KEYS, where)
+    out = {k: to_number(v, f'{where}.{k}') for k, v in data.items()}
+    if 'lower' in out and 'upper' in out and out['lower'] > out['upper']:
+        raise RobotFileError(
+            f'{where}: lower ({out["lower"]}) is above upper '
+            f'({out["upper"]})')
+    for key in ('velocity', 'effort'):
+        if key in out and out[key] <= 0.0:
+            raise RobotFileError(f'{where}.{key}: must be > 0, '
+                                 f'got {out[key]}')
+    return out
+
+
+def robot_from_dict(data, origin='<robot>'):
+    """Validate a parsed robot description; return (model, warnings).
+
+    ``origin`` (usually the file name) starts every error message.
+    """
+    found = []
+    _check_keys(data, TOP_KEYS, origin)
+    for key in ('name', 'convention', 'links'):
+        if key not in data:
+            raise RobotFileError(f'{origin}: missing required key {key!r}')
+    name = data['name']
+    if not isinstance(name, str) or not name.strip():
+        raise RobotFileError(f'{origin}: name: must be a non-empty string')
+    convention = data['convention']
+    if convention not in (STANDARD, MODIFIED):
+        raise RobotFileError(
+            f"{origin}: convention: must be 'standard' or 'modified', "
+            f'got {convention!r}')
+    gravity = to_vector(data.get('gravity', [0.0, 0.0, -9.81]), 3,
+                        f'{origin}: gravity')
+    base = _pose(data['base'], f'{origin}: base') if 'base' in data else None
+    tool = _pose(data['tool'], f'{origin}: tool') if 'tool' in data else None
+    links = data['links']
+    if not isinstance(links, list) or not links:
+        raise RobotFileError(f'{origin}: links: must be a non-empty list')
+    cols = {k: [] for k in ('joint_names', 'joint_types', 'a', 'alpha', 'd',
+                            'theta', 'mass', 'com', 'inertia', 'limits')}
+    for j, link in enumerate(links):
+        label = link.get('name') if isinstance(link, dict) else None
+        where = f'{origin}: links[{j}]' + (f' ({label})' if label else '')
+        _check_keys(link, LINK_KEYS, where)
+        for key in LINK_REQUIRED:
+            if key not in link:
+                raise RobotFileError(f'{where}: missing required key {key!r}')
+        jname = link['name']
+        if not isinstance(jname, str) or not jname.strip():
+            raise RobotFileError(f'{where}: name: must be a non-empty string')
+        if jname in cols['joint_names']:
+            raise RobotFileError(
+                f'{where}: name: {jname!r} is used by an earlier link; '
+                f'joint names must be unique')
+        jtype = link['type']
+        if jtype not in (REVOLUTE, PRISMATIC):
+            raise RobotFileError(
+                f"{where}: type: must be 'revolute' or 'prismatic', "
+                f'got {jtype!r}')
+        cols['joint_names'].append(jname)
+        cols['joint_types'].append(jtype)
+        for key in ('a', 'alpha', 'd'):
+            cols[key].append(to_number(link[key], f'{where}: {key}'))
+        cols['theta'].append(to_number(link.get('theta', 0.0),
+                                       f'{where}: theta'))
+        mass = to_number(link['mass'], f'{where}: mass')
+        if mass < 0.0:
+            raise RobotFileError(f'{where}: mass: must be >= 0, got {mass}')
+        cols['mass'].append(mass)
+        com = to_vector(link['com'], 3, f'{where}: com')
+        cols['com'].append(com)
+        I, eig = _inertia(link['inertia'], f'{where}: inertia')
+        cols['inertia'].append(I)
+        tol = 1e-9 * max(eig[2], 1e-300)
+        if eig[0] + eig[1] < eig[2] - tol:
+            found.append(
+                f'{where}: inertia: principal moments '
+                f'{eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} break the '
+                f'triangle inequality (no real body has them); accepted '
+                f'as published')
+        if mass == 0.0 and any(c != 0.0 for c in com):
+            found.append(f'{where}: com: given for a link of zero mass; '
+                         f'it has no effect')
+        cols['limits'].append(_limits(link['limits'], f'{where}: limits')
+                              if 'limits' in link else {})
+    model = make_model(name=name, convention=convention, gravity=gravity,
+                       base=base, tool=tool, **cols)
+    return model, found
+
+
+def inspect_robot(name_or_path):
+    """Load and validate a robot file; return (model, warnings, path)."""
+    path = resolve_robot_path(name_or_path)
+    data = read_yaml(path)
+    model, found = robot_from_dict(data, os.path.basename(path))
+    return model, found, path
+
+
+def load_robot(name_or_path):
+    """Load a robot file (a path, or a bundled name such as ``'puma560'``).
+
+    Warnings (e.g. inertias that break the triangle inequality) are issued
+    as :class:`RobotFileWarning`; errors raise :class:`RobotFileError`.
+    """
+    model, found, _ = inspect_robot(name_or_path)
+    for message in found:
+        warnings.warn(message, RobotFileWarning, stacklevel=2)
+    return model
