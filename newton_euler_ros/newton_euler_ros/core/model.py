@@ -170,3 +170,59 @@ def inertia_matrix(ixx, iyy, izz, ixy, iyz, ixz):
     """Symmetric 3x3 inertia from [Ixx, Iyy, Izz, Ixy, Iyz, Ixz]."""
     return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]],
                     dtype=np.float64)
+
+
+def _tx_rx(a, alpha):
+    """Homogeneous Tx(a) Rx(alpha)."""
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0, a], [0.0, ca, -sa, 0.0],
+                     [0.0, sa, ca, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def convert_convention(model, convention):
+    """The same robot written in the other DH convention.
+
+    The chain ``Rz Tz Tx Rx | Rz Tz Tx Rx | ...`` (standard) regroups as
+    ``Rz Tz | Tx Rx Rz Tz | ... | Tx Rx`` (modified): modified link frame j
+    is standard frame j without its trailing ``Tx(a_j) Rx(alpha_j)``, which
+    moves into the next row (the last one into the tool).  Centres of mass
+    and inertias are re-expressed in the new link frames, so the dynamics
+    are identical.
+    """
+    if convention == model.convention:
+        return model
+    n = model.n
+    com = np.array(model.com)
+    inertia = np.array(model.inertia)
+    a = np.zeros(n)
+    alpha = np.zeros(n)
+    base = np.array(model.base)
+    tool = np.array(model.tool)
+    if convention == MODIFIED:
+        # X_j = Tx(a_j) Rx(alpha_j) maps standard frame j into modified j.
+        for j in range(n):
+            X = _tx_rx(model.a[j], model.alpha[j])
+            com[j] = X[:3, :3] @ model.com[j] + X[:3, 3]
+            inertia[j] = X[:3, :3] @ model.inertia[j] @ X[:3, :3].T
+            if j + 1 < n:
+                a[j + 1], alpha[j + 1] = model.a[j], model.alpha[j]
+            else:
+                tool = X @ model.tool
+    elif convention == STANDARD:
+        # the first row's Rx(alpha_0) Tx(a_0) moves into the base pose
+        # (Rx(alpha) Tx(a) = Tx(a) Rx(alpha): both act along x)
+        base = base @ _tx_rx(model.a[0], model.alpha[0])
+        for j in range(n):
+            if j + 1 < n:
+                a[j], alpha[j] = model.a[j + 1], model.alpha[j + 1]
+            X = _tx_rx(a[j], alpha[j])
+            Xinv = np.linalg.inv(X)
+            com[j] = Xinv[:3, :3] @ model.com[j] + Xinv[:3, 3]
+            inertia[j] = Xinv[:3, :3] @ model.inertia[j] @ Xinv[:3, :3].T
+        tool = np.linalg.inv(_tx_rx(a[n - 1], alpha[n - 1])) @ model.tool
+    else:
+        raise ValueError(f"convention must be 'standard' or 'modified', "
+                         f'got {convention!r}')
+    return model.replace(convention=convention, a=a, alpha=alpha, com=com,
+                         inertia=inertia, base=base, tool=tool)
+

@@ -1,0 +1,255 @@
+"""``newton-euler``: inverse dynamics of a DH robot from the command line.
+
+    newton-euler dynamics ROBOT --q ... [--qd ...] [--qdd ...]
+                                [--wrench fx fy fz nx ny nz]
+                                [--wrench-frame base|end_effector] [--json]
+    newton-euler dynamics ROBOT --states STATES.json
+    newton-euler check ROBOT
+    newton-euler robots
+
+ROBOT is a robot YAML file or the name of a bundled robot.  Every error is
+one line on stderr and a non-zero exit status.
+"""
+import argparse
+import json
+import sys
+
+import numpy as np
+
+from .core import (NewtonEulerError, coriolis_matrix, gravity_torques,
+                   inspect_robot, inverse_dynamics, jacobian, mass_matrix,
+                   wrench_torques)
+from .core.robot_file import bundled_robots, to_number
+
+EXIT_USAGE = 2
+EXIT_ERROR = 1
+
+
+class CliError(Exception):
+    """A user error, printed as one line."""
+
+
+def _numbers(values, option):
+    return [to_number(v, option) for v in values]
+
+
+def _state_vector(values, n, option):
+    if values is None:
+        return np.zeros(n)
+    x = _numbers(values, option)
+    if len(x) != n:
+        raise CliError(f'{option} needs {n} values (one per joint), '
+                       f'got {len(x)}')
+    return np.array(x)
+
+
+def evaluate(model, q, qd, qdd, wrench, wrench_frame):
+    """All terms at one state, as plain Python lists (JSON-ready)."""
+    tau = inverse_dynamics(model, q, qd, qdd, wrench, wrench_frame)
+    return {
+        'joint_names': list(model.joint_names),
+        'tau': tau.tolist(),
+        'mass_matrix': mass_matrix(model, q).tolist(),
+        'coriolis_matrix': coriolis_matrix(model, q, qd).tolist(),
+        'gravity': gravity_torques(model, q).tolist(),
+        'jacobian': jacobian(model, q, wrench_frame).tolist(),
+    }
+
+
+def _load_states(path, n):
+    try:
+        with open(path, encoding='utf-8') as fh:
+            states = json.load(fh)
+    except OSError as exc:
+        raise CliError(f'{path}: cannot read: {exc.strerror}') from None
+    except json.JSONDecodeError as exc:
+        raise CliError(f'{path}: not valid JSON: {exc}') from None
+    if not isinstance(states, list):
+        raise CliError(f'{path}: must hold a JSON list of states')
+    out = []
+    for i, st in enumerate(states):
+        if not isinstance(st, dict):
+            raise CliError(f'{path}: state {i}: must be an object with '
+                           f'"q", "qd", "qdd", "wrench"')
+        unknown = set(st) - {'q', 'qd', 'qdd', 'wrench'}
+        if unknown:
+            raise CliError(f'{path}: state {i}: unknown key '
+                           f'{sorted(unknown)[0]!r}')
+        vecs = {}
+        for key, size in (('q', n), ('qd', n), ('qdd', n), ('wrench', 6)):
+            value = st.get(key)
+            if value is None:
+                vecs[key] = np.zeros(size)
+                continue
+            if not isinstance(value, list) or len(value) != size:
+                raise CliError(f'{path}: state {i}: {key}: must be a list of '
+                               f'{size} numbers')
+            vecs[key] = np.array(_numbers(value, f'{path}: state {i}: {key}'))
+        out.append(vecs)
+    return out
+
+
+def _fmt(x, width=12):
+    return f'{x:>{width}.6g}'
+
+
+def _matrix_lines(title, names, M, col_names=None):
+    col_names = col_names or names
+    lines = [title, ' ' * 14 + ''.join(f'{c[:11]:>12}' for c in col_names)]
+    for name, row in zip(names, M):
+        lines.append(f'  {name[:12]:<12}' + ''.join(_fmt(v) for v in row))
+    return lines
+
+
+def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
+    """A human-readable report of one evaluation."""
+    names = result['joint_names']
+    D = np.array(result['mass_matrix'])
+    C = np.array(result['coriolis_matrix'])
+    g = np.array(result['gravity'])
+    J = np.array(result['jacobian'])
+    jtf = J.T @ wrench if wrench is not None else np.zeros(len(names))
+    lines = [f'{model.name}: {model.n} joints, {model.convention} DH, '
+             f'gravity {model.gravity.tolist()} m/s^2 (base frame)']
+    if wrench is not None:
+        lines.append(f'end-effector wrench (exerted by the robot, '
+                     f'{wrench_frame} axes): {wrench.tolist()}')
+    lines.append('')
+    head = ('joint', 'type', 'q', 'qd', 'qdd', 'D qdd', 'C qd', 'g',
+            'J^T F', 'tau')
+    lines.append(f'{head[0]:<12}{head[1]:<10}' + ''.join(f'{h:>12}'
+                                                         for h in head[2:]))
+    for j, name in enumerate(names):
+        unit = 'N m' if model.joint_types[j] == 'revolute' else 'N'
+        row = (q[j], qd[j], qdd[j], (D @ qdd)[j], (C @ qd)[j], g[j], jtf[j],
+               result['tau'][j])
+        lines.append(f'{name[:11]:<12}{model.joint_types[j][:9]:<10}'
+                     + ''.join(_fmt(v) for v in row) + f'  {unit}')
+    lines.append('tau = D qdd + C qd + g + J^T F  (N m for revolute, '
+                 'N for prismatic joints)')
+    lines.append('')
+    lines += _matrix_lines('mass matrix D(q):', names, D)
+    lines.append('')
+    lines += _matrix_lines('Coriolis matrix C(q, qd) (Christoffel form):',
+                           names, C)
+    lines.append('')
+    rows = ['vx', 'vy', 'vz', 'wx', 'wy', 'wz']
+    lines += _matrix_lines(f'Jacobian J(q) of the end-effector origin '
+                           f'({wrench_frame} axes):', rows, J, names)
+    return '\n'.join(lines)
+
+
+def cmd_dynamics(args):
+    model, found, _ = inspect_robot(args.robot)
+    for message in found:
+        print(f'warning: {message}', file=sys.stderr)
+    n = model.n
+    if args.states:
+        if any(v is not None for v in (args.q, args.qd, args.qdd,
+                                       args.wrench)):
+            raise CliError('--states replaces --q/--qd/--qdd/--wrench; '
+                           'give one or the other')
+        results = []
+        for st in _load_states(args.states, n):
+            wrench = st['wrench'] if st['wrench'].any() else None
+            results.append(evaluate(model, st['q'], st['qd'], st['qdd'],
+                                    wrench, args.wrench_frame))
+        print(json.dumps(results))
+        return 0
+    if args.q is None:
+        raise CliError(f'--q is required ({n} values, one per joint: '
+                       f'{" ".join(model.joint_names)})')
+    q = _state_vector(args.q, n, '--q')
+    qd = _state_vector(args.qd, n, '--qd')
+    qdd = _state_vector(args.qdd, n, '--qdd')
+    wrench = (np.array(_numbers(args.wrench, '--wrench'))
+              if args.wrench is not None else None)
+    result = evaluate(model, q, qd, qdd, wrench, args.wrench_frame)
+    if args.json:
+        print(json.dumps(result))
+    else:
+        print(format_table(model, result, q, qd, qdd, wrench,
+                           args.wrench_frame))
+    return 0
+
+
+def cmd_check(args):
+    model, found, path = inspect_robot(args.robot)
+    types = ''.join('R' if t == 'revolute' else 'P'
+                    for t in model.joint_types)
+    print(f'{path}: OK')
+    print(f'  name: {model.name}')
+    print(f'  joints: {model.n} ({types}), {model.convention} DH')
+    print(f'  joint names: {", ".join(model.joint_names)}')
+    print(f'  total mass: {model.total_mass:.6g} kg')
+    print(f'  gravity: {model.gravity.tolist()} m/s^2')
+    print(f'  warnings: {len(found)}')
+    for message in found:
+        print(f'  warning: {message}')
+    return 0
+
+
+def cmd_robots(_args):
+    for name in bundled_robots():
+        print(name)
+    return 0
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        raise CliError(message)
+
+
+def build_parser():
+    parser = _Parser(prog='newton-euler', description=__doc__.split('\n')[0])
+    sub = parser.add_subparsers(dest='command', parser_class=_Parser)
+    dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
+    dyn.add_argument('robot', help='robot YAML file or bundled robot name')
+    dyn.add_argument('--q', nargs='+', metavar='Q',
+                     help='joint positions (rad or m)')
+    dyn.add_argument('--qd', nargs='+', metavar='QD',
+                     help='joint velocities (default zeros)')
+    dyn.add_argument('--qdd', nargs='+', metavar='QDD',
+                     help='joint accelerations (default zeros)')
+    dyn.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
+                                                   'NY', 'NZ'),
+                     help='wrench the end effector exerts on its '
+                          'environment (N, N m), moment about its origin')
+    dyn.add_argument('--wrench-frame', choices=('base', 'end_effector'),
+                     default='base', help='axes of --wrench and of the '
+                                          'Jacobian (default base)')
+    dyn.add_argument('--json', action='store_true',
+                     help='print one JSON object')
+    dyn.add_argument('--states', metavar='FILE.json',
+                     help='evaluate a JSON list of {"q","qd","qdd","wrench"}'
+                          ' and print a JSON list')
+    dyn.set_defaults(func=cmd_dynamics)
+    chk = sub.add_parser('check', help='validate a robot file')
+    chk.add_argument('robot')
+    chk.set_defaults(func=cmd_check)
+    rob = sub.add_parser('robots', help='list the bundled robots')
+    rob.set_defaults(func=cmd_robots)
+    return parser
+
+
+def main(argv=None):
+    """Entry point of the ``newton-euler`` console script."""
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if args.command is None:
+            parser.print_help()
+            return EXIT_USAGE
+        return args.func(args)
+    except CliError as exc:
+        print(f'newton-euler: error: {exc}', file=sys.stderr)
+        return EXIT_USAGE
+    except NewtonEulerError as exc:
+        print(f'newton-euler: error: {exc}', file=sys.stderr)
+        return EXIT_ERROR
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == '__main__':
+    sys.exit(main())
