@@ -96,7 +96,7 @@ def _raise_nonfinite(code, values):
     arg, i = divmod(code, 1000)
     name = _ARG_NAMES[arg]
     raise DynamicsInputError(
-        f'{name}[{i}] is {values[arg][i]!r}; every entry must be finite')
+        f'{name}[{i}] is {float(values[arg][i])!r}; every entry must be finite')
 
 
 def _check_finite(q, qd, qdd, wrench):
@@ -181,7 +181,7 @@ def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
         if bad.size:
             r, c = bad[0]
             raise DynamicsInputError(
-                f'{name}[{r}, {c}] is {X[r, c]!r}; every entry must be finite')
+                f'{name}[{r}, {c}] is {float(X[r, c])!r}; every entry must be finite')
     TAU = np.empty((m, n)) if out is None else out
     K.inverse_dynamics_batch(model.links_array, model.frames_array, Q, QD,
                              QDD, W, gravity, velocity_products, mode, ws.ws,
@@ -322,7 +322,7 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
     if K.first_nonfinite(tau) >= 0:
         i = K.first_nonfinite(tau)
         raise DynamicsInputError(
-            f'tau[{i}] is {tau[i]!r}; every entry must be finite')
+            f'tau[{i}] is {float(tau[i])!r}; every entry must be finite')
     bias = inverse_dynamics(model, q, qd, None, wrench, wrench_frame,
                             gravity=gravity,
                             velocity_products=velocity_products, ws=ws)

@@ -1,0 +1,123 @@
+"""The newton-euler command, run as a real process."""
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+PUMA_Q = ['0', '0.5', '-0.3', '0.1', '0.2', '0.3']
+PUMA_QD = ['0.1', '0.2', '0.3', '0.4', '0.5', '0.6']
+
+
+def run(*args, cwd=None):
+    proc = subprocess.run(
+        [sys.executable, '-m', 'newton_euler_ros.cli', *args],
+        capture_output=True, text=True, timeout=120, cwd=cwd,
+        env=dict(os.environ))
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def test_json_terms_satisfy_the_equation_of_motion():
+    qdd = ['1', '-1', '0.5', '0', '2', '-0.5']
+    wrench = ['10', '-5', '3', '0.5', '0.2', '-0.1']
+    code, out, err = run('dynamics', 'puma560', '--q', *PUMA_Q, '--qd',
+                         *PUMA_QD, '--qdd', *qdd, '--wrench', *wrench,
+                         '--json')
+    assert code == 0, err
+    res = json.loads(out)
+    assert set(res) == {'joint_names', 'tau', 'mass_matrix',
+                        'coriolis_matrix', 'gravity', 'jacobian'}
+    assert res['joint_names'] == [f'joint{i}' for i in range(1, 7)]
+    D = np.array(res['mass_matrix'])
+    C = np.array(res['coriolis_matrix'])
+    J = np.array(res['jacobian'])
+    assert D.shape == C.shape == (6, 6) and J.shape == (6, 6)
+    rhs = (D @ np.array(qdd, float) + C @ np.array(PUMA_QD, float)
+           + np.array(res['gravity']) + J.T @ np.array(wrench, float))
+    np.testing.assert_allclose(res['tau'], rhs, rtol=0, atol=1e-12)
+
+
+def test_table_is_readable():
+    code, out, err = run('dynamics', 'puma560', '--q', *PUMA_Q, '--qd',
+                         *PUMA_QD)
+    assert code == 0, err
+    assert 'puma560: 6 joints, standard DH' in out
+    assert 'mass matrix D(q):' in out and 'Jacobian J(q)' in out
+    assert 'warning: puma560.yaml: links[0]' in err   # published oddity
+
+
+def test_states_file_keeps_order_and_fills_zeros(tmp_path):
+    states = [{'q': [0.1, 0.2]}, {'q': [0.3, -0.4], 'qd': [1.0, 2.0],
+                                  'qdd': [0.5, 0.0],
+                                  'wrench': [1, 2, 3, 0, 0, 0]}]
+    path = tmp_path / 'states.json'
+    path.write_text(json.dumps(states))
+    code, out, err = run('dynamics', 'planar_2r', '--states', str(path))
+    assert code == 0, err
+    res = json.loads(out)
+    assert len(res) == 2
+    for st, r in zip(states, res):
+        code, out1, _ = run('dynamics', 'planar_2r', '--q',
+                            *map(str, st['q']), '--json',
+                            *(['--qd', *map(str, st['qd'])] if 'qd' in st
+                              else []),
+                            *(['--qdd', *map(str, st['qdd'])] if 'qdd' in st
+                              else []),
+                            *(['--wrench', *map(str, st['wrench'])]
+                              if 'wrench' in st else []))
+        assert json.loads(out1) == r
+
+
+def test_check_summarises_or_fails():
+    code, out, _ = run('check', 'stanford')
+    assert code == 0
+    assert 'joints: 6 (RRPRRR), standard DH' in out
+    assert 'total mass:' in out
+
+
+@pytest.mark.parametrize('args, message', [
+    (['dynamics', 'puma560', '--q', '1', '2'],
+     '--q needs 6 values (one per joint), got 2'),
+    (['dynamics', 'puma560', '--q', *PUMA_Q[:5], 'nan'],
+     '--q: must be finite'),
+    (['dynamics', 'puma560', '--q', *PUMA_Q[:5], 'abc'],
+     '--q: must be a number'),
+    (['dynamics', 'puma560'], '--q is required (6 values'),
+    (['dynamics', 'no_such_robot', '--q', '0'], 'not a bundled robot'),
+    (['dynamics', 'puma560', '--q', *PUMA_Q, '--wrench', '1', '2'],
+     'expected 6 arguments'),
+    (['dynamics', 'puma560', '--q', *PUMA_Q, '--wrench-frame', 'tool'],
+     "invalid choice: 'tool'"),
+    (['check', 'missing.yaml'], 'missing.yaml: no such file'),
+    (['frobnicate'], "invalid choice: 'frobnicate'"),
+])
+def test_errors_are_one_line_without_traceback(args, message):
+    code, out, err = run(*args)
+    assert code != 0
+    lines = [ln for ln in err.splitlines() if not ln.startswith('warning:')]
+    assert len(lines) == 1, err
+    assert lines[0].startswith('newton-euler: error: ')
+    assert message in lines[0]
+    assert 'Traceback' not in err
+
+
+def test_bad_robot_file_error_names_field(tmp_path):
+    path = tmp_path / 'arm.yaml'
+    path.write_text('name: arm\nconvention: standard\nlinks:\n'
+                    '  - {name: j1, type: revolute, a: 1.0, alpha: 0.0, '
+                    'd: 0.0, mass: -2.0, com: [0, 0, 0], '
+                    'inertia: [1, 1, 1, 0, 0, 0]}\n')
+    code, _, err = run('check', str(path))
+    assert code == 1
+    assert err.strip() == ('newton-euler: error: arm.yaml: links[0] (j1): '
+                           'mass: must be >= 0, got -2.0')
+
+
+def test_bad_states_file(tmp_path):
+    path = tmp_path / 'states.json'
+    path.write_text('[{"q": [0.1]}]')
+    code, _, err = run('dynamics', 'planar_2r', '--states', str(path))
+    assert code != 0
+    assert 'state 0: q: must be a list of 2 numbers' in err

@@ -1,0 +1,79 @@
+"""Bad input to the library raises DynamicsInputError naming the argument
+and the index; nothing non-finite comes out of finite input."""
+import doctest
+import math
+
+import numpy as np
+import pytest
+
+from newton_euler_ros.core import (DynamicsInputError, coriolis_matrix,
+                                   forward_dynamics, gravity_torques,
+                                   inverse_dynamics, inverse_dynamics_batch,
+                                   jacobian, load_robot, make_model,
+                                   mass_matrix, NotPositiveDefiniteError,
+                                   wrench_torques)
+from newton_euler_ros.core import dynamics, robot_file
+
+
+@pytest.fixture(scope='module')
+def arm():
+    return load_robot('planar_2r')
+
+
+@pytest.mark.parametrize('call, message', [
+    (lambda m: inverse_dynamics(m, [0.0]), 'q must have 2 entries, got 1'),
+    (lambda m: inverse_dynamics(m, [[0.0, 0.0]]), 'q must be a vector'),
+    (lambda m: inverse_dynamics(m, ['a', 0.0]), 'q must be a sequence'),
+    (lambda m: inverse_dynamics(m, [0.0, math.nan]), r'q\[1\] is nan'),
+    (lambda m: inverse_dynamics(m, [0, 0], [0, math.inf]), r'qd\[1\] is inf'),
+    (lambda m: inverse_dynamics(m, [0, 0], None, [-math.inf, 0]),
+     r'qdd\[0\] is -inf'),
+    (lambda m: inverse_dynamics(m, [0, 0], wrench=[0, 0, 0, 0, math.nan, 0]),
+     r'wrench\[4\] is nan'),
+    (lambda m: inverse_dynamics(m, [0, 0], wrench=[0, 0, 0]),
+     'wrench must have 6 entries, got 3'),
+    (lambda m: inverse_dynamics(m, [0, 0], wrench=[0] * 6,
+                                wrench_frame='tool'),
+     "wrench_frame must be 'base' or 'end_effector'"),
+    (lambda m: mass_matrix(m, [math.nan, 0]), r'q\[0\] is nan'),
+    (lambda m: coriolis_matrix(m, [0, 0], [0, math.nan]), r'qd\[1\] is nan'),
+    (lambda m: gravity_torques(m, [0, 0, 0]), 'q must have 2 entries'),
+    (lambda m: jacobian(m, [0, 0], frame='world'), "frame must be 'base'"),
+    (lambda m: wrench_torques(m, [0, 0], [math.inf] + [0] * 5),
+     r'wrench\[0\] is inf'),
+    (lambda m: forward_dynamics(m, [0, 0], [0, 0], [0, math.nan]),
+     r'tau\[1\] is nan'),
+    (lambda m: inverse_dynamics_batch(m, np.zeros((3, 2)),
+                                      np.full((3, 2), math.nan)),
+     r'QD\[0, 0\] is nan'),
+    (lambda m: inverse_dynamics_batch(m, np.zeros((3, 3))),
+     r'Q must have shape \(m, 2\)'),
+])
+def test_bad_state_raises_named_error(arm, call, message):
+    with pytest.raises(DynamicsInputError, match=message):
+        call(arm)
+
+
+def test_error_leaves_output_untouched(arm):
+    out = np.array([7.0, 7.0])
+    with pytest.raises(DynamicsInputError):
+        inverse_dynamics(arm, [0.0, math.nan], out=out)
+    assert out.tolist() == [7.0, 7.0]
+
+
+def test_massless_tail_names_the_joint():
+    # the second joint moves nothing: D is singular at joint index 1
+    tail = make_model('tail', 'standard', ['j1', 'tip'],
+                      ['revolute', 'revolute'], [1.0, 0.5], [0, 0], [0, 0],
+                      [0, 0], [1.0, 0.0], np.zeros((2, 3)),
+                      [np.eye(3) * 0.1, np.zeros((3, 3))])
+    with pytest.raises(NotPositiveDefiniteError, match=r'joint 1 \(tip\)') \
+            as info:
+        forward_dynamics(tail, [0, 0], [0, 0], [1.0, 1.0])
+    assert info.value.joint == 1
+
+
+def test_docstring_examples_run():
+    for module in (dynamics, robot_file):
+        result = doctest.testmod(module)
+        assert result.failed == 0
