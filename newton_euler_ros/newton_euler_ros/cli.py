@@ -89,13 +89,13 @@ def _load_states(path, n):
     return out
 
 
-def _fmt(x, width=12):
+def _fmt(x, width=13):
     return f'{x:>{width}.6g}'
 
 
 def _matrix_lines(title, names, M, col_names=None):
     col_names = col_names or names
-    lines = [title, ' ' * 14 + ''.join(f'{c[:11]:>12}' for c in col_names)]
+    lines = [title, ' ' * 14 + ''.join(f'{c[:12]:>13}' for c in col_names)]
     for name, row in zip(names, M):
         lines.append(f'  {name[:12]:<12}' + ''.join(_fmt(v) for v in row))
     return lines
@@ -117,7 +117,7 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
     lines.append('')
     head = ('joint', 'type', 'q', 'qd', 'qdd', 'D qdd', 'C qd', 'g',
             'J^T F', 'tau')
-    lines.append(f'{head[0]:<12}{head[1]:<10}' + ''.join(f'{h:>12}'
+    lines.append(f'{head[0]:<12}{head[1]:<10}' + ''.join(f'{h:>13}'
                                                          for h in head[2:]))
     for j, name in enumerate(names):
         unit = 'N m' if model.joint_types[j] == 'revolute' else 'N'

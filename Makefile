@@ -1,0 +1,49 @@
+# newton_euler_ros: one-command set-up, tests, demo and benchmark.
+#   make setup   create/refresh .venv (idempotent; < 2 s when up to date)
+#   make test    set up if needed, then run pytest over newton_euler_ros/test
+#   make demo    run the CLI on the PUMA 560
+#   make bench   run the benchmark
+#   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
+#   make colcon-check  build both packages as a ROS 2 workspace with colcon
+#   make clean   remove build/, .venv and the stamps in it
+# Extra pytest arguments: make test PYTEST_ARGS='-k rnea -x'
+
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DEFAULT_GOAL := test
+
+VENV := .venv
+PY   := $(VENV)/bin/python
+PYTEST_ARGS ?=
+
+# Tests must not see (or be seen by) ROS 2 nodes on other hosts; override on
+# the command line only if you mean it (make test ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET).
+export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
+# Keep rclpy's log files and numba's JIT cache inside the (ignored) build dir.
+export ROS_LOG_DIR := $(CURDIR)/build/ros_log
+export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
+
+.PHONY: setup test demo bench peers colcon-check clean
+
+setup:
+	@bash scripts/setup_env.sh
+
+test: setup
+	$(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
+
+demo: setup
+	$(VENV)/bin/newton-euler dynamics puma560 --q 0 0.5 -0.3 0.1 0.2 0.3 --qd 0.1 0.2 0.3 0.4 0.5 0.6
+
+bench: setup
+	$(PY) -m newton_euler_ros.bench
+
+# Constrained by the main lock so the peers cannot move numpy & co.
+peers: setup
+	$(PY) -m pip install --progress-bar off -q -c requirements/constraints.txt -r requirements/peers.txt
+	$(PY) -c "import pinocchio, roboticstoolbox; print('pinocchio', pinocchio.__version__, '| roboticstoolbox', roboticstoolbox.__version__)"
+
+colcon-check: setup
+	bash scripts/colcon_check.sh
+
+clean:
+	rm -rf build $(VENV) newton_euler_ros/*.egg-info

@@ -1,0 +1,42 @@
+"""Launch inverse_dynamics_node with a bundled parameter file (apt ROS).
+
+    ros2 launch newton_euler_ros inverse_dynamics.launch.py robot:=puma560
+
+Remap ``joint_states`` and ``wrench`` as your graph needs, e.g.
+``ros2 launch ... joint_states:=/my_robot/joint_states``.
+"""
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration, PythonExpression
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    share = get_package_share_directory('newton_euler_ros')
+    robot = LaunchConfiguration('robot')
+    params = PythonExpression([
+        "'", os.path.join(share, 'config', 'params', ''), "' + '", robot,
+        "' + '.yaml'"])
+    return LaunchDescription([
+        DeclareLaunchArgument('robot', default_value='puma560',
+                              description='bundled robot whose parameter '
+                                          'file to load'),
+        DeclareLaunchArgument('params_file', default_value=params,
+                              description='parameter file (overrides robot)'),
+        DeclareLaunchArgument('joint_states', default_value='joint_states'),
+        DeclareLaunchArgument('wrench', default_value='wrench'),
+        Node(
+            package='newton_euler_ros',
+            executable='inverse_dynamics_node',
+            name='inverse_dynamics_node',
+            output='screen',
+            parameters=[LaunchConfiguration('params_file')],
+            remappings=[
+                ('joint_states', LaunchConfiguration('joint_states')),
+                ('wrench', LaunchConfiguration('wrench')),
+            ],
+        ),
+    ])

@@ -1,0 +1,311 @@
+"""Feedforward torque computation behind the ROS node, free of ROS.
+
+The node converts messages to plain Python/numpy values and calls into
+this module; everything here is testable without a ROS graph:
+
+- :class:`JointOrder` maps named joint vectors (any order, extra joints)
+  onto the model's joint order and back to the output order.
+- :class:`WrenchInput` keeps the latest end-effector wrench with its frame,
+  sign convention and age.
+- :class:`ReferenceTrajectory` samples desired accelerations from a joint
+  trajectory.
+- :class:`FeedforwardComputer` ties them to the dynamics.
+
+Every rejection raises :class:`InputRejected` with a one-line reason and a
+short ``kind`` used for counters.
+"""
+import math
+
+import numpy as np
+
+from .core import (Workspace, coriolis_matrix, gravity_torques,
+                   inverse_dynamics, mass_matrix)
+
+EXERTED_BY_ROBOT = 'exerted_by_robot'
+APPLIED_TO_ROBOT = 'applied_to_robot'
+
+
+class InputRejected(Exception):
+    """An input message cannot be used; ``kind`` names the counter."""
+
+    def __init__(self, kind, message):
+        super().__init__(message)
+        self.kind = kind
+
+
+class JointOrder:
+    """Map named joint values onto a model's joints, and out again.
+
+    Parameters
+    ----------
+    model_joints : names in the model's order (the dynamics' order).
+    output_joints : names in the order results are published, a
+        permutation of ``model_joints``.
+    """
+
+    def __init__(self, model_joints, output_joints=None):
+        self.model_joints = tuple(model_joints)
+        output = tuple(output_joints) if output_joints else self.model_joints
+        if len(set(output)) != len(output):
+            dup = next(j for j in output if output.count(j) > 1)
+            raise ValueError(f'joints: {dup!r} is listed twice')
+        if set(output) != set(self.model_joints):
+            missing = sorted(set(self.model_joints) - set(output))
+            extra = sorted(set(output) - set(self.model_joints))
+            raise ValueError(
+                'joints: must name every joint of the robot exactly once'
+                + (f'; missing {missing}' if missing else '')
+                + (f'; not in the robot: {extra}' if extra else ''))
+        self.output_joints = output
+        index = {name: i for i, name in enumerate(self.model_joints)}
+        #: out[k] = model_vector[self.to_output[k]]
+        self.to_output = np.array([index[j] for j in output], dtype=np.intp)
+        self._cache_names = None
+        self._cache_take = None
+
+    @property
+    def n(self):
+        return len(self.model_joints)
+
+    def _take(self, names):
+        """Indices into a message's arrays giving the model's order."""
+        if names == self._cache_names:
+            return self._cache_take
+        where = {}
+        for i, name in enumerate(names):
+            if name in where:
+                raise InputRejected('malformed',
+                                    f'joint {name!r} appears twice')
+            where[name] = i
+        missing = [j for j in self.model_joints if j not in where]
+        if missing:
+            raise InputRejected('missing_joints',
+                                f'missing joints {missing}')
+        take = np.array([where[j] for j in self.model_joints], dtype=np.intp)
+        self._cache_names = list(names)
+        self._cache_take = take
+        return take
+
+    def gather(self, names, field, values, required=True):
+        """Model-ordered float64 vector of one field (position, ...).
+
+        An empty ``values`` gives None when not ``required``.
+        """
+        names = list(names)
+        if len(values) == 0 and not required:
+            return None
+        if len(values) != len(names):
+            raise InputRejected(
+                'malformed', f'{field} has {len(values)} entries for '
+                f'{len(names)} names')
+        take = self._take(names)
+        x = np.asarray(values, dtype=np.float64)[take]
+        if not np.isfinite(x).all():
+            k = int(np.argmin(np.isfinite(x)))
+            raise InputRejected(
+                'non_finite', f'{field} of {self.model_joints[k]!r} is '
+                f'{float(x[k])!r}')
+        return x
+
+    def to_output_order(self, x):
+        return x[self.to_output]
+
+    def matrix_to_output_order(self, M):
+        return M[np.ix_(self.to_output, self.to_output)]
+
+
+class WrenchInput:
+    """The latest end-effector wrench, as the dynamics expect it.
+
+    Parameters
+    ----------
+    base_frames, end_effector_frames : ``header.frame_id`` values taken as
+        base-frame or end-effector-frame axes.
+    convention : ``'exerted_by_robot'`` (the library's F_e) or
+        ``'applied_to_robot'`` (what a wrist force/torque sensor reports:
+        the wrench the environment applies; it is negated).
+    timeout : seconds after which a wrench is stale (0 disables).
+    """
+
+    def __init__(self, base_frames, end_effector_frames,
+                 convention=EXERTED_BY_ROBOT, timeout=0.5):
+        both = set(base_frames) & set(end_effector_frames)
+        if both:
+            raise ValueError(f'frame {sorted(both)[0]!r} is listed as both a '
+                             f'base and an end-effector frame')
+        if convention not in (EXERTED_BY_ROBOT, APPLIED_TO_ROBOT):
+            raise ValueError(f"wrench convention must be '{EXERTED_BY_ROBOT}'"
+                             f" or '{APPLIED_TO_ROBOT}', got {convention!r}")
+        if not (timeout >= 0.0 and math.isfinite(timeout)):
+            raise ValueError(f'wrench timeout must be >= 0 s, got {timeout}')
+        self.frames = {f: 'base' for f in base_frames}
+        self.frames.update({f: 'end_effector' for f in end_effector_frames})
+        self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
+        self.timeout = timeout
+        self.wrench = None
+        self.frame = 'base'
+        self.stamp = None
+        self.expired = 0
+
+    def update(self, frame_id, values, stamp, now):
+        """Accept a wrench [fx, fy, fz, tx, ty, tz] stamped ``stamp`` (s)."""
+        frame = self.frames.get(frame_id)
+        if frame is None:
+            raise InputRejected(
+                'unknown_frame', f'wrench frame_id {frame_id!r} is not one '
+                f'of {sorted(self.frames)}')
+        w = np.asarray(values, dtype=np.float64)
+        if not np.isfinite(w).all():
+            raise InputRejected('non_finite', f'wrench has a non-finite '
+                                f'entry: {w.tolist()}')
+        if stamp == 0.0:          # unstamped: take it as of now
+            stamp = now
+        if self.timeout and now - stamp > self.timeout:
+            raise InputRejected(
+                'stale', f'wrench is {now - stamp:.3f} s old (timeout '
+                f'{self.timeout} s)')
+        self.wrench = self.sign * w
+        self.frame = frame
+        self.stamp = stamp
+
+    def current(self, now):
+        """(wrench or None, frame).
+
+        A wrench older than the timeout is dropped (the torques are then
+        computed without it) and ``expired`` counts that event once.
+        """
+        if self.wrench is None:
+            return None, self.frame
+        if self.timeout and now - self.stamp > self.timeout:
+            self.wrench = None
+            self.expired += 1
+            return None, self.frame
+        return self.wrench, self.frame
+
+
+class ReferenceTrajectory:
+    """Desired joint accelerations sampled from a joint trajectory.
+
+    Accelerations are interpolated linearly in time between points; before
+    the first point the first is used, after the last the last.  Points
+    without accelerations count as zero.
+    """
+
+    def __init__(self, order):
+        self.order = order
+        self.times = None
+        self.accelerations = None
+        self.start = 0.0
+
+    def set(self, names, start, points, now):
+        """``points``: list of (time_from_start s, accelerations list)."""
+        if not points:
+            self.times = None
+            return
+        times = np.array([p[0] for p in points], dtype=np.float64)
+        if not np.isfinite(times).all() or np.any(np.diff(times) < 0.0):
+            raise InputRejected('malformed', 'reference trajectory times '
+                                'must be finite and non-decreasing')
+        acc = np.zeros((len(points), self.order.n))
+        for k, (_, values) in enumerate(points):
+            if len(values):
+                acc[k] = self.order.gather(names, f'point {k} accelerations',
+                                           values)
+        self.times = times
+        self.accelerations = acc
+        self.start = now if start == 0.0 else start
+
+    def acceleration(self, t):
+        if self.times is None:
+            return None
+        s = t - self.start
+        times, acc = self.times, self.accelerations
+        if s <= times[0]:
+            return acc[0].copy()
+        if s >= times[-1]:
+            return acc[-1].copy()
+        k = int(np.searchsorted(times, s, side='right'))
+        t0, t1 = times[k - 1], times[k]
+        w = (s - t0) / (t1 - t0) if t1 > t0 else 1.0
+        return (1.0 - w) * acc[k - 1] + w * acc[k]
+
+
+class FeedforwardComputer:
+    """tau = D qdd + C qd + g + J^T F_e for named joint states.
+
+    Holds the model, a workspace, the joint order, the wrench and the
+    reference, so that a node only converts messages.
+    """
+
+    def __init__(self, model, order, wrench_input, reference=None):
+        self.model = model
+        self.order = order
+        self.wrench = wrench_input
+        self.reference = reference
+        self.ws = Workspace(model)
+        self.tau = np.empty(model.n)
+        self.last_q = None
+        self.last_qd = None
+
+    def warm_up(self):
+        """Run every code path once so the first message is not slow (the
+        compiled kernels load from numba's cache, or compile once)."""
+        z = np.zeros(self.model.n)
+        for frame in ('base', 'end_effector'):
+            inverse_dynamics(self.model, z, z, z, np.zeros(6), frame,
+                             ws=self.ws)
+        inverse_dynamics(self.model, z, z, z, ws=self.ws)
+        mass_matrix(self.model, z, ws=self.ws)
+        coriolis_matrix(self.model, z, z, ws=self.ws)
+        gravity_torques(self.model, z, ws=self.ws)
+
+    def torques(self, names, position, velocity, stamp, now):
+        """Output-ordered torques for one joint state, or InputRejected."""
+        q = self.order.gather(names, 'position', position)
+        qd = self.order.gather(names, 'velocity', velocity, required=False)
+        if qd is None:
+            qd = np.zeros(self.model.n)
+        qdd = (self.reference.acceleration(stamp)
+               if self.reference is not None else None)
+        self.last_q, self.last_qd = q, qd
+        w, frame = self.wrench.current(now)
+        tau = inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws,
+                               out=self.tau)
+        if not np.isfinite(tau).all():   # finite input; guard the output
+            raise InputRejected('non_finite', 'dynamics produced a '
+                                'non-finite torque')
+        return self.order.to_output_order(tau)
+
+    def terms(self, names, position, velocity, acceleration, now):
+        """D, C, g, tau in output order for a service request.
+
+        Empty position/velocity mean the latest measured state; empty
+        acceleration means zeros.
+        """
+        n = self.model.n
+        if len(position) == 0:
+            if self.last_q is None:
+                raise InputRejected('no_state', 'no position given and no '
+                                    'joint state received yet')
+            q = self.last_q
+        else:
+            q = self.order.gather(names, 'position', position)
+        if len(velocity) == 0:
+            qd = self.last_qd if (len(position) == 0 and self.last_qd
+                                  is not None) else np.zeros(n)
+        else:
+            qd = self.order.gather(names, 'velocity', velocity)
+        qdd = (np.zeros(n) if len(acceleration) == 0 else
+               self.order.gather(names, 'acceleration', acceleration))
+        w, frame = self.wrench.current(now)
+        D = mass_matrix(self.model, q, ws=self.ws)
+        C = coriolis_matrix(self.model, q, qd, ws=self.ws)
+        g = gravity_torques(self.model, q, ws=self.ws)
+        tau = inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws)
+        o = self.order
+        out = (o.matrix_to_output_order(D), o.matrix_to_output_order(C),
+               o.to_output_order(g), o.to_output_order(tau))
+        if not all(np.isfinite(x).all() for x in out):
+            raise InputRejected('non_finite', 'dynamics produced a '
+                                'non-finite value')
+        return out

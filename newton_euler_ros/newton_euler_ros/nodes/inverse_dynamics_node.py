@@ -1,0 +1,289 @@
+"""inverse_dynamics_node: joint states (and a wrench) in, torques out.
+
+A thin adapter: messages are converted to numpy, the library computes, the
+result is published.  See the README ("ROS 2 node") for the interface.
+
+Subscribes
+    joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
+    WrenchStamped), ~/reference (trajectory_msgs/JointTrajectory, only
+    with acceleration_source = reference)
+Publishes
+    ~/torque_command (std_msgs/Float64MultiArray), ~/torques
+    (sensor_msgs/JointState), /diagnostics (diagnostic_msgs/DiagnosticArray)
+Serves
+    ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
+"""
+import sys
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
+from newton_euler_interfaces.srv import ComputeDynamics
+import rclpy
+from rclpy.executors import ExternalShutdownException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray
+from trajectory_msgs.msg import JointTrajectory
+
+from ..core import NewtonEulerError, inspect_robot
+from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
+                           ReferenceTrajectory, WrenchInput)
+from ..parameters import load_specs, validate
+
+_PARAM_TYPES = {
+    'string': Parameter.Type.STRING, 'double': Parameter.Type.DOUBLE,
+    'int': Parameter.Type.INTEGER, 'bool': Parameter.Type.BOOL,
+    'string_array': Parameter.Type.STRING_ARRAY,
+    'double_array': Parameter.Type.DOUBLE_ARRAY,
+}
+COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
+            'unknown_frame', 'stale', 'expired', 'no_state',
+            'service_calls', 'service_failures', 'internal_error')
+
+
+class ConfigurationError(Exception):
+    """The node's parameters are invalid; it refuses to start."""
+
+
+def _seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+class InverseDynamicsNode(Node):
+    """Feedforward torques from joint states, by Newton-Euler."""
+
+    def __init__(self, **kwargs):
+        super().__init__('inverse_dynamics_node', **kwargs)
+        self.specs = load_specs()
+        p = self._declare_parameters()
+        try:
+            model, found, path = inspect_robot(p['robot_file'])
+        except NewtonEulerError as exc:
+            raise ConfigurationError(f'robot_file: {exc}') from None
+        for message in found:
+            self.get_logger().warning(f'robot file: {message}')
+        try:
+            order = JointOrder(model.joint_names, p['joints'] or None)
+            wrench = self._wrench_input(p)
+        except ValueError as exc:
+            raise ConfigurationError(str(exc)) from None
+        reference = (ReferenceTrajectory(order)
+                     if p['acceleration_source'] == 'reference' else None)
+        self.ff = FeedforwardComputer(model, order, wrench, reference)
+        self.ff.warm_up()   # compile or load the kernels before any message
+        self.counts = dict.fromkeys(COUNTERS, 0)
+        self.log_throttle = p['log_throttle']
+        self._last_log = {}
+
+        qos = QoSProfile(depth=p['qos.depth'], reliability=(
+            ReliabilityPolicy.RELIABLE if p['qos.reliability'] == 'reliable'
+            else ReliabilityPolicy.BEST_EFFORT))
+        self.cmd_pub = self.create_publisher(Float64MultiArray,
+                                             '~/torque_command', qos)
+        self.torque_pub = self.create_publisher(JointState, '~/torques', qos)
+        self.create_subscription(JointState, 'joint_states',
+                                 self._on_joint_state, qos)
+        self.create_subscription(WrenchStamped, 'wrench', self._on_wrench,
+                                 qos)
+        if reference is not None:
+            self.create_subscription(JointTrajectory, '~/reference',
+                                     self._on_reference, 10)
+        self.create_service(ComputeDynamics, '~/compute_dynamics',
+                            self._on_compute_dynamics)
+        if p['diagnostics_period'] > 0.0:
+            self.diag_pub = self.create_publisher(DiagnosticArray,
+                                                  '/diagnostics', 10)
+            self.create_timer(p['diagnostics_period'], self._publish_counts)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
+        # reused messages: the hot path allocates no message objects
+        self._cmd = Float64MultiArray()
+        self._torques = JointState()
+        self._torques.name = list(order.output_joints)
+        self.get_logger().info(
+            f'{model.name} ({path}): {model.n} joints '
+            f'[{", ".join(order.output_joints)}], qdd from '
+            f'{p["acceleration_source"]}, wrench frames '
+            f'{sorted(wrench.frames)}')
+
+    # ---- parameters ----
+    def _declare_parameters(self):
+        values = {}
+        for spec in self.specs:
+            desc = ParameterDescriptor(description=spec.description,
+                                       read_only=spec.read_only)
+            if spec.default == [] or spec.default == '':
+                # an empty default does not tell rclpy the type
+                self.declare_parameter(spec.name, _PARAM_TYPES[spec.type],
+                                       desc)
+                param = self.get_parameter_or(spec.name, None)
+                value = param.value if param is not None else None
+                values[spec.name] = spec.default if value is None else value
+            else:
+                values[spec.name] = self.declare_parameter(
+                    spec.name, spec.default, desc).value
+            if isinstance(values[spec.name], tuple):
+                values[spec.name] = list(values[spec.name])
+        errors = validate(values, self.specs)
+        if errors:
+            raise ConfigurationError('; '.join(errors))
+        return values
+
+    def _wrench_input(self, p):
+        return WrenchInput(p['wrench.base_frames'],
+                           p['wrench.end_effector_frames'],
+                           p['wrench.convention'], p['wrench.timeout'])
+
+    def _on_set_parameters(self, params):
+        values = {}
+        for param in params:
+            values[param.name] = (list(param.value)
+                                  if isinstance(param.value, (tuple, list))
+                                  else param.value)
+        errors = validate(values, self.specs)
+        if errors:
+            return SetParametersResult(successful=False,
+                                       reason='; '.join(errors))
+        current = {s.name: values.get(s.name,
+                                      self.get_parameter(s.name).value)
+                   for s in self.specs if s.name.startswith('wrench.')}
+        current = {k: list(v) if isinstance(v, tuple) else v
+                   for k, v in current.items()}
+        try:
+            new_wrench = self._wrench_input(current)
+        except ValueError as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        if any(name.startswith('wrench.') for name in values):
+            self.ff.wrench = new_wrench
+        if 'log_throttle' in values:
+            self.log_throttle = values['log_throttle']
+        return SetParametersResult(successful=True)
+
+    # ---- inputs ----
+    def _now(self):
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _reject(self, source, exc):
+        kind = exc.kind if isinstance(exc, InputRejected) else \
+            'internal_error'
+        self.counts[kind] += 1
+        last = self._last_log.get(kind, -1e300)
+        now = time.monotonic()
+        if now - last >= self.log_throttle:
+            self._last_log[kind] = now
+            self.get_logger().warning(
+                f'dropped {source}: {exc} ({kind}: {self.counts[kind]} so '
+                f'far)')
+
+    def _on_joint_state(self, msg):
+        try:
+            expired = self.ff.wrench.expired
+            tau = self.ff.torques(msg.name, msg.position, msg.velocity,
+                                  _seconds(msg.header.stamp), self._now())
+            if self.ff.wrench.expired != expired:
+                self._reject('wrench', InputRejected(
+                    'expired', 'the last wrench is older than '
+                    f'{self.ff.wrench.timeout} s; torques no longer include '
+                    f'it'))
+        except InputRejected as exc:
+            self._reject('joint state', exc)
+            return
+        except Exception as exc:  # never let a message kill the node
+            self._reject('joint state', exc)
+            return
+        values = tau.tolist()
+        self._cmd.data = values
+        self.cmd_pub.publish(self._cmd)
+        self._torques.header.stamp = msg.header.stamp
+        self._torques.effort = values
+        self.torque_pub.publish(self._torques)
+        self.counts['published'] += 1
+
+    def _on_wrench(self, msg):
+        w = msg.wrench
+        try:
+            self.ff.wrench.update(
+                msg.header.frame_id,
+                (w.force.x, w.force.y, w.force.z,
+                 w.torque.x, w.torque.y, w.torque.z),
+                _seconds(msg.header.stamp), self._now())
+        except InputRejected as exc:
+            self._reject('wrench', exc)
+        except Exception as exc:
+            self._reject('wrench', exc)
+
+    def _on_reference(self, msg):
+        try:
+            points = [(_seconds(pt.time_from_start), pt.accelerations)
+                      for pt in msg.points]
+            self.ff.reference.set(msg.joint_names, _seconds(msg.header.stamp),
+                                  points, self._now())
+        except InputRejected as exc:
+            self._reject('reference', exc)
+        except Exception as exc:
+            self._reject('reference', exc)
+
+    def _on_compute_dynamics(self, request, response):
+        self.counts['service_calls'] += 1
+        try:
+            D, C, g, tau = self.ff.terms(
+                request.name, request.position, request.velocity,
+                request.acceleration, self._now())
+        except (InputRejected, NewtonEulerError) as exc:
+            self.counts['service_failures'] += 1
+            response.success = False
+            response.message = str(exc)
+            return response
+        except Exception as exc:
+            self._reject('service request', exc)
+            self.counts['service_failures'] += 1
+            response.success = False
+            response.message = f'internal error: {exc}'
+            return response
+        response.success = True
+        response.message = ''
+        response.name = list(self.ff.order.output_joints)
+        response.mass_matrix = D.ravel().tolist()
+        response.coriolis_matrix = C.ravel().tolist()
+        response.gravity = g.tolist()
+        response.torque = tau.tolist()
+        return response
+
+    def _publish_counts(self):
+        status = DiagnosticStatus(
+            level=DiagnosticStatus.OK, name=self.get_fully_qualified_name(),
+            message='input counters', hardware_id=self.ff.model.name)
+        status.values = [KeyValue(key=k, value=str(v))
+                         for k, v in self.counts.items()]
+        msg = DiagnosticArray(status=[status])
+        msg.header.stamp = self.get_clock().now().to_msg()
+        self.diag_pub.publish(msg)
+
+
+def main(args=None):
+    """Entry point of the ``inverse_dynamics_node`` console script."""
+    rclpy.init(args=args)
+    node = None
+    code = 0
+    try:
+        node = InverseDynamicsNode()
+        rclpy.spin(node)
+    except ConfigurationError as exc:
+        # refuse to start, with the reason on one line
+        print(f'inverse_dynamics_node: invalid parameters: {exc}',
+              file=sys.stderr)
+        code = 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
+
+
+if __name__ == '__main__':
+    sys.exit(main())

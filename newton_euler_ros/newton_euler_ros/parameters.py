@@ -1,0 +1,126 @@
+"""Node parameters from one schema file, without ROS.
+
+``inverse_dynamics_parameters.yaml`` (beside this module) lists every
+parameter with its type, default, description, ``read_only`` flag and
+validation rules, in the style of generate_parameter_library.  This module
+reads it, validates values and renders the README table; the node declares
+its parameters from the same :class:`ParameterSpec` list.
+
+    python -m newton_euler_ros.parameters --markdown
+"""
+import math
+import os
+import sys
+
+import yaml
+
+SCHEMA = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                      'inverse_dynamics_parameters.yaml')
+TYPES = {'string': str, 'double': float, 'int': int, 'bool': bool,
+         'string_array': list, 'double_array': list}
+
+
+class ParameterSpec:
+    """One declared parameter: name (dotted), type, default, rules."""
+
+    def __init__(self, name, entry):
+        self.name = name
+        self.type = entry['type']
+        if self.type not in TYPES:
+            raise ValueError(f'{SCHEMA}: {name}: unknown type {self.type!r}')
+        self.default = entry['default_value']
+        self.description = entry['description']
+        self.read_only = bool(entry.get('read_only', False))
+        self.validation = entry.get('validation') or {}
+
+    def check(self, value):
+        """'' when ``value`` is valid, else a one-line reason."""
+        if self.type == 'double' and isinstance(value, int) and \
+                not isinstance(value, bool):
+            value = float(value)
+        want = TYPES[self.type]
+        if not isinstance(value, want) or (want is int and
+                                           isinstance(value, bool)):
+            return f'{self.name}: must be of type {self.type}, got {value!r}'
+        if self.type == 'double' and not math.isfinite(value):
+            return f'{self.name}: must be finite, got {value!r}'
+        if self.type == 'string_array' and not all(isinstance(v, str)
+                                                   for v in value):
+            return f'{self.name}: must be a list of strings, got {value!r}'
+        for rule, args in self.validation.items():
+            reason = _RULES[rule](value, *(args or []))
+            if reason:
+                return f'{self.name}: {reason}'
+        return ''
+
+
+def _one_of(value, choices):
+    return '' if value in choices else (
+        f'must be one of {", ".join(map(repr, choices))}, got {value!r}')
+
+
+def _gt(value, bound):
+    return '' if value > bound else f'must be > {bound}, got {value!r}'
+
+
+def _gt_eq(value, bound):
+    return '' if value >= bound else f'must be >= {bound}, got {value!r}'
+
+
+def _not_empty(value):
+    return '' if len(value) else 'must not be empty'
+
+
+def _unique(value):
+    dup = [v for i, v in enumerate(value) if v in value[:i]]
+    return '' if not dup else f'{dup[0]!r} is listed twice'
+
+
+_RULES = {'one_of<>': _one_of, 'gt<>': _gt, 'gt_eq<>': _gt_eq,
+          'not_empty<>': _not_empty, 'unique<>': _unique}
+
+
+def _flatten(tree, prefix=''):
+    for key, entry in tree.items():
+        name = f'{prefix}{key}'
+        if isinstance(entry, dict) and 'type' in entry:
+            yield ParameterSpec(name, entry)
+        else:
+            yield from _flatten(entry, name + '.')
+
+
+def load_specs(node_name='inverse_dynamics_node', path=SCHEMA):
+    """The parameters of ``node_name`` as a list of ParameterSpec."""
+    with open(path, encoding='utf-8') as fh:
+        schema = yaml.safe_load(fh)
+    return list(_flatten(schema[node_name]))
+
+
+def validate(values, specs):
+    """Reasons (possibly none) why a {name: value} mapping is invalid."""
+    return [r for r in (s.check(values[s.name]) for s in specs
+                        if s.name in values) if r]
+
+
+def markdown_table(specs):
+    """The parameter table for the README."""
+    lines = ['| parameter | type | default | read-only | description |',
+             '|---|---|---|---|---|']
+    for s in specs:
+        default = yaml.safe_dump(s.default, default_flow_style=True).strip()
+        if default.endswith('...'):
+            default = default[:-3].strip()
+        rules = '; '.join(f'{k[:-2]} {v}' if v else k[:-2]
+                          for k, v in s.validation.items())
+        desc = s.description + (f' *Validation: {rules}.*' if rules else '')
+        lines.append(f'| `{s.name}` | {s.type} | `{default}` | '
+                     f'{"yes" if s.read_only else "no"} | {desc} |')
+    return '\n'.join(lines)
+
+
+if __name__ == '__main__':
+    if sys.argv[1:] != ['--markdown']:
+        print('usage: python -m newton_euler_ros.parameters --markdown',
+              file=sys.stderr)
+        sys.exit(2)
+    print(markdown_table(load_specs()))

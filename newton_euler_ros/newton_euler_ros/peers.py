@@ -1,0 +1,162 @@
+"""Peer-library models built from a :class:`~newton_euler_ros.core.RobotModel`.
+
+Used by :mod:`newton_euler_ros.bench` to time the same robot in other
+rigid-body dynamics libraries, and usable on its own to cross-check our
+results against theirs.  Neither peer is a dependency of the package: every
+builder imports its library lazily and raises ``ImportError`` when it is
+missing.
+
+Pinocchio (``import pinocchio``)
+    One revolute (``JointModelRZ``) or prismatic (``JointModelPZ``) joint per
+    DH row, each moving about the z axis of its own joint frame.
+
+    *Standard DH*, ``A_j = Rz(theta_j + q_j) Tz(d_j) Tx(a_j) Rx(alpha_j)``
+    (q_j in d_j instead for a prismatic joint):
+    joint j moves about z_{j-1}, so the joint frame J_j is link frame j-1
+    turned (or slid) by q_j about its own z axis, and link frame j is
+    ``J_j X_j`` with the fixed
+    ``X_j = Rz(theta_j) Tz(d_j) Tx(a_j) Rx(alpha_j)``
+    (Rz and Tz commute, so this holds for both joint types).  Hence the
+    placement of J_j in J_{j-1} is ``X_{j-1}`` (``base`` for the first
+    joint), and the centre of mass and inertia of link j, given in link
+    frame j, are carried into J_j by ``X_j``.
+
+    *Modified DH*, ``A_j = Rx(alpha_j) Tx(a_j) Rz(theta_j + q_j) Tz(d_j)``:
+    Rz(q) and Tz(d) commute too, so link frame j is
+    ``frame_{j-1} Rx(alpha_j) Tx(a_j) Rz(theta_j) Tz(d_j) Rz(q_j)`` (or
+    ``... Tz(d_j) Tz(q_j)`` for a prismatic joint): the joint
+    frame *is* link frame j, its placement is that fixed product (preceded
+    by ``base`` for the first joint) and the inertias go in unchanged.
+
+    Gravity is ``model.gravity`` in the universe (= our base) frame.
+
+Robotics Toolbox for Python (``import roboticstoolbox``)
+    A ``DHRobot`` of ``RevoluteDH``/``PrismaticDH`` (standard) or
+    ``RevoluteMDH``/``PrismaticMDH`` (modified) links with the same
+    ``m``, ``r`` (centre of mass in link frame j) and ``I`` (about the centre
+    of mass, link-frame axes) as ours, and no motor inertia, gearing or
+    friction (``Jm = 0``, ``G = 1``, ``B = 0``, ``Tc = 0``).  Our ``theta``
+    (revolute) or ``d`` (prismatic) becomes the toolbox's joint ``offset``.
+"""
+import math
+
+import numpy as np
+
+from .core.model import MODIFIED, REVOLUTE, STANDARD
+
+
+def _rz(theta):
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0, 0.0], [s, c, 0.0, 0.0],
+                     [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def _rx(alpha):
+    c, s = math.cos(alpha), math.sin(alpha)
+    return np.array([[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, 0.0],
+                     [0.0, s, c, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def _trans(x, y, z):
+    T = np.eye(4)
+    T[:3, 3] = (x, y, z)
+    return T
+
+
+def fixed_dh_transform(model, j):
+    """The part of joint j's DH transform that does not move, 4x4.
+
+    Standard: ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``; modified:
+    ``Rx(alpha) Tx(a) Rz(theta) Tz(d)`` (the joint variable then acts as
+    a rotation or translation about/along the z axis of the joint frame,
+    see the module docstring for where that frame sits).
+    """
+    a, alpha = float(model.a[j]), float(model.alpha[j])
+    d, theta = float(model.d[j]), float(model.theta[j])
+    if model.convention == STANDARD:
+        return (_rz(theta) @ _trans(0.0, 0.0, d) @ _trans(a, 0.0, 0.0)
+                @ _rx(alpha))
+    return _rx(alpha) @ _trans(a, 0.0, 0.0) @ _rz(theta) @ _trans(0.0, 0.0, d)
+
+
+def pinocchio_model(model):
+    """A ``pinocchio.Model`` with the same dynamics as ``model``.
+
+    Joint j of ours is Pinocchio joint ``j + 1`` (0 is the universe); the
+    configuration and velocity vectors are the same as ours.
+    """
+    import pinocchio as pin
+
+    pm = pin.Model()
+    pm.name = model.name
+    parent = 0
+    for j in range(model.n):
+        X = fixed_dh_transform(model, j)
+        if model.convention == STANDARD:
+            placement = (np.array(model.base) if j == 0
+                         else fixed_dh_transform(model, j - 1))
+            to_joint = X                    # link frame j in joint frame j
+        else:
+            placement = (np.array(model.base) @ X if j == 0 else X)
+            to_joint = np.eye(4)
+        R, p = to_joint[:3, :3], to_joint[:3, 3]
+        com = R @ np.asarray(model.com[j]) + p
+        inertia = R @ np.asarray(model.inertia[j]) @ R.T
+        inertia = 0.5 * (inertia + inertia.T)
+        joint = (pin.JointModelRZ() if model.joint_types[j] == REVOLUTE
+                 else pin.JointModelPZ())
+        jid = pm.addJoint(parent, joint,
+                          pin.SE3(placement[:3, :3].copy(),
+                                  placement[:3, 3].copy()),
+                          model.joint_names[j])
+        pm.appendBodyToJoint(jid, pin.Inertia(float(model.mass[j]), com,
+                                              inertia), pin.SE3.Identity())
+        parent = jid
+    pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float),
+                            np.zeros(3))
+    return pm
+
+
+def rtb_robot(model):
+    """A ``roboticstoolbox.DHRobot`` with the same dynamics as ``model``."""
+    import roboticstoolbox as rtb
+    from spatialmath import SE3
+
+    links = []
+    for j in range(model.n):
+        dyn = dict(m=float(model.mass[j]), r=np.array(model.com[j]),
+                   I=np.array(model.inertia[j]), Jm=0.0, G=1.0, B=0.0,
+                   Tc=np.zeros(2))
+        a, alpha = float(model.a[j]), float(model.alpha[j])
+        d, theta = float(model.d[j]), float(model.theta[j])
+        revolute = model.joint_types[j] == REVOLUTE
+        if model.convention == MODIFIED:
+            link = (rtb.RevoluteMDH(d=d, a=a, alpha=alpha, offset=theta, **dyn)
+                    if revolute else
+                    rtb.PrismaticMDH(theta=theta, a=a, alpha=alpha, offset=d,
+                                     **dyn))
+        else:
+            link = (rtb.RevoluteDH(d=d, a=a, alpha=alpha, offset=theta, **dyn)
+                    if revolute else
+                    rtb.PrismaticDH(theta=theta, a=a, alpha=alpha, offset=d,
+                                    **dyn))
+        link.name = model.joint_names[j]
+        links.append(link)
+    robot = rtb.DHRobot(links, name=model.name,
+                        base=SE3(np.array(model.base), check=False),
+                        tool=SE3(np.array(model.tool), check=False),
+                        gravity=np.array(model.gravity))
+    return robot
+
+
+def versions():
+    """{library: version string, or 'unavailable: <reason>'}."""
+    out = {}
+    for label, module in (('pinocchio', 'pinocchio'),
+                          ('roboticstoolbox', 'roboticstoolbox')):
+        try:
+            mod = __import__(module)
+            out[label] = str(getattr(mod, '__version__', 'unknown'))
+        except Exception as exc:  # ImportError, or a broken binary wheel
+            out[label] = f'unavailable: {type(exc).__name__}: {exc}'
+    return out
