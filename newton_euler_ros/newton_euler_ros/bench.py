@@ -1,5 +1,21 @@
-"""Benchmark: our Newton-Euler dynamics against Pinocchio, Robotics Toolbox
-and a naive numpy recursion, with the performance targets checked.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Benchmark our Newton-Euler dynamics and check the performance targets.
+
+The peers are Pinocchio, Robotics Toolbox and a naive numpy recursion.
 
     python -m newton_euler_ros.bench [--quick] [--json PATH]
                                      [--robot NAME ...] [--seed N]
@@ -38,10 +54,10 @@ import warnings
 import numpy as np
 
 from . import peers
-from .core import (NewtonEulerError, Workspace, coriolis_matrix,
-                   gravity_torques, inverse_dynamics, inverse_dynamics_batch,
-                   load_robot, mass_matrix)
 from .core import _kernels as K
+from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
+                   inverse_dynamics_batch, load_robot, mass_matrix,
+                   NewtonEulerError, Workspace)
 from .core import dynamics as _dynamics
 from .core.model import REVOLUTE, STANDARD
 
@@ -65,7 +81,8 @@ OP_LABELS = {
 
 
 class Timer:
-    """``perf_counter_ns`` around a loop of N calls, repeated R times.
+    """
+    ``perf_counter_ns`` around a loop of N calls, repeated R times.
 
     N is chosen so that one repeat lasts about ``target_ns``; two calls
     before that are a warm-up.  The loop is ``timeit``'s compiled one
@@ -95,9 +112,13 @@ class Timer:
         return timer, number
 
     def group(self, entries):
-        """{key: (stmt, namespace, number or None, states per call)} ->
+        """
+        Time several statements with their repeats interleaved.
+
+        {key: (stmt, namespace, number or None, states per call)} ->
         {key: {'min_us', 'median_us', 'number', 'reps', 'states'}}, the
-        times per state (per call when states is 1)."""
+        times per state (per call when states is 1).
+        """
         prepared = {key: self._prepare(stmt, ns, number)
                     for key, (stmt, ns, number, _) in entries.items()}
         samples = {key: [] for key in entries}
@@ -140,7 +161,8 @@ def _naive_dh(model, j, qj):
 
 
 def naive_rnea(model, q, qd, qdd, gravity=True):
-    """Newton-Euler in base-frame vectors with ``np.cross`` and ``@``.
+    """
+    Newton-Euler in base-frame vectors with ``np.cross`` and ``@``.
 
     Forward: pose of every link by 4x4 products, then the angular velocity
     and acceleration and the acceleration of each centre of mass, passed
@@ -342,17 +364,18 @@ def bench_robot(name, timer, rng, log):
     rtb_ns = _setup_rtb(model, check_states, ref, result, log)
 
     # ---- our public API and raw kernels ----
-    ns = dict(model=model, q=q, qd=qd, qdd=qdd, ws=ws, tau=tau, D=D, C=C,
-              g=g, Q=Q, QD=QD, QDD=QDD, TAU=TAU, W=W, K=K,
-              links=model.links_array, frames=model.frames_array,
-              inverse_dynamics=inverse_dynamics, mass_matrix=mass_matrix,
-              coriolis_matrix=coriolis_matrix,
-              gravity_torques=gravity_torques,
-              inverse_dynamics_batch=inverse_dynamics_batch,
-              naive_rnea=naive_rnea, naive_mass_matrix=naive_mass_matrix,
-              zeros=np.zeros(n), zero_w=np.zeros(6), wsa=ws.ws,
-              scratch=ws.scratch, _vector=_dynamics._vector, n=n,
-              WN=K.WRENCH_NONE)
+    ns = {'model': model, 'q': q, 'qd': qd, 'qdd': qdd, 'ws': ws,
+          'tau': tau, 'D': D, 'C': C, 'g': g, 'Q': Q, 'QD': QD, 'QDD': QDD,
+          'TAU': TAU, 'W': W, 'K': K,
+          'links': model.links_array, 'frames': model.frames_array,
+          'inverse_dynamics': inverse_dynamics, 'mass_matrix': mass_matrix,
+          'coriolis_matrix': coriolis_matrix,
+          'gravity_torques': gravity_torques,
+          'inverse_dynamics_batch': inverse_dynamics_batch,
+          'naive_rnea': naive_rnea, 'naive_mass_matrix': naive_mass_matrix,
+          'zeros': np.zeros(n), 'zero_w': np.zeros(6), 'wsa': ws.ws,
+          'scratch': ws.scratch, '_vector': _dynamics._vector, 'n': n,
+          'WN': K.WRENCH_NONE}
     stmts = {
         'tau': 'inverse_dynamics(model, q, qd, qdd, ws=ws, out=tau)',
         'D': 'mass_matrix(model, q, ws=ws, out=D)',
@@ -475,9 +498,9 @@ def _setup_pinocchio(model, states, ref, result, log):
     if not valid:
         log('                Pinocchio model disagrees with ours: its '
             'timings are marked INVALID')
-    return dict(pm=pm, pd=pd, rnea=pin.rnea, crba=pin.crba,
-                computeCoriolisMatrix=pin.computeCoriolisMatrix,
-                computeGeneralizedGravity=pin.computeGeneralizedGravity)
+    return {'pm': pm, 'pd': pd, 'rnea': pin.rnea, 'crba': pin.crba,
+            'computeCoriolisMatrix': pin.computeCoriolisMatrix,
+            'computeGeneralizedGravity': pin.computeGeneralizedGravity}
 
 
 def _setup_rtb(model, states, ref, result, log):
@@ -511,7 +534,7 @@ def _setup_rtb(model, states, ref, result, log):
     if not valid:
         log('                RTB model disagrees with ours: its timings are '
             'marked INVALID')
-    return dict(robot=robot)
+    return {'robot': robot}
 
 
 # --------------------------------------------------------------------------
@@ -681,8 +704,8 @@ def print_misses(result, log):
                         ('numba dispatch', b['dispatch_us']),
                         ('kernel compute', b['compute_us'])),
                        key=lambda kv: -kv[1])
-        log('     split: ' + ', '.join(f'{k} {x:.3f} ({100 * x / pub:.0f}%)'
-                                      for k, x in parts))
+        log('     split: ' + ', '.join(
+            f'{k} {x:.3f} ({100 * x / pub:.0f}%)' for k, x in parts))
         top = parts[0][0]
         if top == 'kernel compute' and op in ('D', 'C'):
             log(f'     dominant: the {n} full recursions '
@@ -695,7 +718,7 @@ def print_misses(result, log):
         elif top == 'numba dispatch':
             log(f'     dominant: numba dispatch (type-checking and unboxing '
                 f'the arguments); that alone is {b["dispatch_us"] / pin:.2f}x '
-                f'Pinocchio\'s whole call')
+                f"Pinocchio's whole call")
         else:
             log(f'     dominant: Python work in the public wrapper '
                 f'(argument conversion/validation, default workspace); '
@@ -706,7 +729,7 @@ def print_misses(result, log):
 # --------------------------------------------------------------------------
 # first-call compile / cache-load time, in a fresh interpreter
 
-_FIRST_CALL = r'''
+_FIRST_CALL = r"""
 import json, time, warnings
 t0 = time.perf_counter()
 from newton_euler_ros.core import (load_robot, inverse_dynamics, mass_matrix,
@@ -737,7 +760,7 @@ print(json.dumps({'import_s': t1 - t0, 'load_robot_s': t2 - t1,
                   'first_batch_s': t6 - t5,
                   'second_inverse_dynamics_s': t7 - t6,
                   'import_to_first_tau_s': t3 - t0}))
-'''
+"""
 
 
 def first_call_times(robot, cache_dir=None):
@@ -827,8 +850,8 @@ def main(argv=None):
     if load_start is not None:
         log(f'load average at start: {load_start:.2f} on {os.cpu_count()} '
             f'cpus' + ('  (WARNING: other work is running; figures will be '
-                      'noisy and our Python-side costs hit hardest)'
-                      if load_start > 0.5 else ''))
+                       'noisy and our Python-side costs hit hardest)'
+                       if load_start > 0.5 else ''))
     timer = Timer(args.quick)
     rng = np.random.default_rng(args.seed)
     try:

@@ -1,4 +1,19 @@
-"""``newton-euler``: inverse dynamics of a DH robot from the command line.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+``newton-euler``: inverse dynamics of a DH robot from the command line.
 
     newton-euler dynamics ROBOT --q ... [--qd ...] [--qdd ...]
                                 [--wrench fx fy fz nx ny nz]
@@ -16,9 +31,8 @@ import sys
 
 import numpy as np
 
-from .core import (NewtonEulerError, coriolis_matrix, gravity_torques,
-                   inspect_robot, inverse_dynamics, jacobian, mass_matrix,
-                   wrench_torques)
+from .core import (coriolis_matrix, gravity_torques, inspect_robot,
+                   inverse_dynamics, jacobian, mass_matrix, NewtonEulerError)
 from .core.robot_file import bundled_robots, to_number
 
 EXIT_USAGE = 2
@@ -102,7 +116,7 @@ def _matrix_lines(title, names, M, col_names=None):
 
 
 def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
-    """A human-readable report of one evaluation."""
+    """Return a human-readable, multi-line report of one evaluation."""
     names = result['joint_names']
     D = np.array(result['mass_matrix'])
     C = np.array(result['coriolis_matrix'])
@@ -201,7 +215,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser():
-    parser = _Parser(prog='newton-euler', description=__doc__.split('\n')[0])
+    parser = _Parser(prog='newton-euler', description=__doc__.strip().split('\n')[0])
     sub = parser.add_subparsers(dest='command', parser_class=_Parser)
     dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
     dyn.add_argument('robot', help='robot YAML file or bundled robot name')

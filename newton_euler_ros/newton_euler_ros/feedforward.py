@@ -1,4 +1,19 @@
-"""Feedforward torque computation behind the ROS node, free of ROS.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Feedforward torque computation behind the ROS node, free of ROS.
 
 The node converts messages to plain Python/numpy values and calls into
 this module; everything here is testable without a ROS graph:
@@ -18,8 +33,8 @@ import math
 
 import numpy as np
 
-from .core import (Workspace, coriolis_matrix, gravity_torques,
-                   inverse_dynamics, mass_matrix)
+from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
+                   mass_matrix, Workspace)
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
@@ -34,13 +49,15 @@ class InputRejected(Exception):
 
 
 class JointOrder:
-    """Map named joint values onto a model's joints, and out again.
+    """
+    Map named joint values onto a model's joints, and out again.
 
     Parameters
     ----------
     model_joints : names in the model's order (the dynamics' order).
     output_joints : names in the order results are published, a
         permutation of ``model_joints``.
+
     """
 
     def __init__(self, model_joints, output_joints=None):
@@ -68,7 +85,7 @@ class JointOrder:
         return len(self.model_joints)
 
     def _take(self, names):
-        """Indices into a message's arrays giving the model's order."""
+        """Return the indices into a message's arrays that give the model's order."""
         if names == self._cache_names:
             return self._cache_take
         where = {}
@@ -87,7 +104,8 @@ class JointOrder:
         return take
 
     def gather(self, names, field, values, required=True):
-        """Model-ordered float64 vector of one field (position, ...).
+        """
+        Model-ordered float64 vector of one field (position, ...).
 
         An empty ``values`` gives None when not ``required``.
         """
@@ -115,7 +133,8 @@ class JointOrder:
 
 
 class WrenchInput:
-    """The latest end-effector wrench, as the dynamics expect it.
+    """
+    The latest end-effector wrench, as the dynamics expect it.
 
     Parameters
     ----------
@@ -125,6 +144,7 @@ class WrenchInput:
         ``'applied_to_robot'`` (what a wrist force/torque sensor reports:
         the wrench the environment applies; it is negated).
     timeout : seconds after which a wrench is stale (0 disables).
+
     """
 
     def __init__(self, base_frames, end_effector_frames,
@@ -138,8 +158,8 @@ class WrenchInput:
                              f" or '{APPLIED_TO_ROBOT}', got {convention!r}")
         if not (timeout >= 0.0 and math.isfinite(timeout)):
             raise ValueError(f'wrench timeout must be >= 0 s, got {timeout}')
-        self.frames = {f: 'base' for f in base_frames}
-        self.frames.update({f: 'end_effector' for f in end_effector_frames})
+        self.frames = dict.fromkeys(base_frames, 'base')
+        self.frames.update(dict.fromkeys(end_effector_frames, 'end_effector'))
         self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
         self.timeout = timeout
         self.wrench = None
@@ -169,7 +189,8 @@ class WrenchInput:
         self.stamp = stamp
 
     def current(self, now):
-        """(wrench or None, frame).
+        """
+        (wrench or None, frame).
 
         A wrench older than the timeout is dropped (the torques are then
         computed without it) and ``expired`` counts that event once.
@@ -184,7 +205,8 @@ class WrenchInput:
 
 
 class ReferenceTrajectory:
-    """Desired joint accelerations sampled from a joint trajectory.
+    """
+    Desired joint accelerations sampled from a joint trajectory.
 
     Accelerations are interpolated linearly in time between points; before
     the first point the first is used, after the last the last.  Points
@@ -197,7 +219,7 @@ class ReferenceTrajectory:
         self.accelerations = None
         self.start = 0.0
 
-    def set(self, names, start, points, now):
+    def set(self, names, start, points, now):  # noqa: A003 (public API name)
         """``points``: list of (time_from_start s, accelerations list)."""
         if not points:
             self.times = None
@@ -231,7 +253,8 @@ class ReferenceTrajectory:
 
 
 class FeedforwardComputer:
-    """tau = D qdd + C qd + g + J^T F_e for named joint states.
+    """
+    tau = D qdd + C qd + g + J^T F_e for named joint states.
 
     Holds the model, a workspace, the joint order, the wrench and the
     reference, so that a node only converts messages.
@@ -248,8 +271,11 @@ class FeedforwardComputer:
         self.last_qd = None
 
     def warm_up(self):
-        """Run every code path once so the first message is not slow (the
-        compiled kernels load from numba's cache, or compile once)."""
+        """
+        Run every code path once so the first message is not slow.
+
+        The compiled kernels load from numba's cache, or compile once.
+        """
         z = np.zeros(self.model.n)
         for frame in ('base', 'end_effector'):
             inverse_dynamics(self.model, z, z, z, np.zeros(6), frame,
@@ -277,7 +303,8 @@ class FeedforwardComputer:
         return self.order.to_output_order(tau)
 
     def terms(self, names, position, velocity, acceleration, now):
-        """D, C, g, tau in output order for a service request.
+        """
+        D, C, g, tau in output order for a service request.
 
         Empty position/velocity mean the latest measured state; empty
         acceleration means zeros.

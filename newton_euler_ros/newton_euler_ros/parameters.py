@@ -1,4 +1,19 @@
-"""Node parameters from one schema file, without ROS.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Node parameters from one schema file, without ROS.
 
 ``inverse_dynamics_parameters.yaml`` (beside this module) lists every
 parameter with its type, default, description, ``read_only`` flag and
@@ -90,7 +105,7 @@ def _flatten(tree, prefix=''):
 
 
 def load_specs(node_name='inverse_dynamics_node', path=SCHEMA):
-    """The parameters of ``node_name`` as a list of ParameterSpec."""
+    """Return the parameters of ``node_name`` as a list of ParameterSpec."""
     with open(path, encoding='utf-8') as fh:
         schema = yaml.safe_load(fh)
     return list(_flatten(schema[node_name]))
@@ -103,7 +118,7 @@ def validate(values, specs):
 
 
 def markdown_table(specs):
-    """The parameter table for the README."""
+    """Render the specs as the Markdown parameter table of the README."""
     lines = ['| parameter | type | default | read-only | description |',
              '|---|---|---|---|---|']
     for s in specs:

@@ -1,4 +1,19 @@
-"""Peer-library models built from a :class:`~newton_euler_ros.core.RobotModel`.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Peer-library models built from a :class:`~newton_euler_ros.core.RobotModel`.
 
 Used by :mod:`newton_euler_ros.bench` to time the same robot in other
 rigid-body dynamics libraries, and usable on its own to cross-check our
@@ -64,7 +79,8 @@ def _trans(x, y, z):
 
 
 def fixed_dh_transform(model, j):
-    """The part of joint j's DH transform that does not move, 4x4.
+    """
+    Return the part of joint j's DH transform that does not move, 4x4.
 
     Standard: ``Rz(theta) Tz(d) Tx(a) Rx(alpha)``; modified:
     ``Rx(alpha) Tx(a) Rz(theta) Tz(d)`` (the joint variable then acts as
@@ -80,7 +96,8 @@ def fixed_dh_transform(model, j):
 
 
 def pinocchio_model(model):
-    """A ``pinocchio.Model`` with the same dynamics as ``model``.
+    """
+    Build a ``pinocchio.Model`` with the same dynamics as ``model``.
 
     Joint j of ours is Pinocchio joint ``j + 1`` (0 is the universe); the
     configuration and velocity vectors are the same as ours.
@@ -118,15 +135,15 @@ def pinocchio_model(model):
 
 
 def rtb_robot(model):
-    """A ``roboticstoolbox.DHRobot`` with the same dynamics as ``model``."""
+    """Build a ``roboticstoolbox.DHRobot`` with the same dynamics as ``model``."""
     import roboticstoolbox as rtb
     from spatialmath import SE3
 
     links = []
     for j in range(model.n):
-        dyn = dict(m=float(model.mass[j]), r=np.array(model.com[j]),
-                   I=np.array(model.inertia[j]), Jm=0.0, G=1.0, B=0.0,
-                   Tc=np.zeros(2))
+        dyn = {'m': float(model.mass[j]), 'r': np.array(model.com[j]),
+               'I': np.array(model.inertia[j]), 'Jm': 0.0, 'G': 1.0, 'B': 0.0,
+               'Tc': np.zeros(2)}
         a, alpha = float(model.a[j]), float(model.alpha[j])
         d, theta = float(model.d[j]), float(model.theta[j])
         revolute = model.joint_types[j] == REVOLUTE

@@ -1,4 +1,19 @@
-"""An independent Euler-Lagrange reference for serial DH arms (test oracle).
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+An independent Euler-Lagrange reference for serial DH arms (test oracle).
 
 Nothing here is imported from ``newton_euler_ros``: the only coupling is that
 the functions read the public fields of a model object (``a, alpha, d,
@@ -88,8 +103,12 @@ def trans_z(d):
 
 
 def dh_transform(convention, a, alpha, d, theta):
-    """Standard: Rz(theta) Tz(d) Tx(a) Rx(alpha); modified (Craig):
-    Rx(alpha) Tx(a) Rz(theta) Tz(d)."""
+    """
+    Return the 4x4 DH transform of one joint in the given convention.
+
+    Standard: Rz(theta) Tz(d) Tx(a) Rx(alpha); modified (Craig):
+    Rx(alpha) Tx(a) Rz(theta) Tz(d).
+    """
     if convention == STANDARD:
         return rot_z(theta) @ trans_z(d) @ trans_x(a) @ rot_x(alpha)
     return rot_x(alpha) @ trans_x(a) @ rot_z(theta) @ trans_z(d)
@@ -99,7 +118,8 @@ def dh_transform(convention, a, alpha, d, theta):
 # forward kinematics
 # ---------------------------------------------------------------------------
 def forward_kinematics(model, q):
-    """Poses in the base frame, and the joint axes.
+    """
+    Poses in the base frame, and the joint axes.
 
     Returns ``(T, axes)``: ``T`` is a list of n + 2 (4, 4) arrays, frame 0,
     link frames 1..n and the end effector; ``axes[j] = (z, o)`` is the unit
@@ -158,8 +178,12 @@ def _column(model, k, z, o, p):
 
 
 def com_jacobians(model, q):
-    """For each link j: (Jv (3, n), Jw (3, n)) of its centre of mass, base
-    axes, and its rotation R_j (3, 3) in the base frame."""
+    """
+    Centre-of-mass Jacobians and rotation of every link.
+
+    For each link j: (Jv (3, n), Jw (3, n)) of its centre of mass, base
+    axes, and its rotation R_j (3, 3) in the base frame.
+    """
     T, axes = forward_kinematics(model, q)
     n = len(model.joint_types)
     dt = _dtype(q)
@@ -177,8 +201,11 @@ def com_jacobians(model, q):
 
 
 def ee_jacobian(model, q, frame='base'):
-    """Geometric Jacobian (6, n) of the end-effector origin, rows [v; w],
-    base axes (or end-effector axes with ``frame='end_effector'``)."""
+    """
+    Geometric Jacobian (6, n) of the end-effector origin, rows [v; w].
+
+    Base axes (or end-effector axes with ``frame='end_effector'``).
+    """
     T, axes = forward_kinematics(model, q)
     n = len(model.joint_types)
     pe = T[-1][:3, 3]
@@ -200,8 +227,8 @@ def mass_matrix(model, q):
     n = len(model.joint_types)
     D = np.zeros((n, n), dtype=_dtype(q))
     for j, (Jv, Jw, R) in enumerate(com_jacobians(model, q)):
-        I = R @ np.asarray(model.inertia[j]) @ R.T
-        D = D + model.mass[j] * (Jv.T @ Jv) + Jw.T @ I @ Jw
+        inertia = R @ np.asarray(model.inertia[j]) @ R.T
+        D = D + model.mass[j] * (Jv.T @ Jv) + Jw.T @ inertia @ Jw
     return D
 
 
@@ -269,8 +296,12 @@ def _vee(S):
 
 
 def kinetic_energy(model, q, qd, method='complex'):
-    """sum_j 1/2 m |v_c|^2 + 1/2 w^T R I R^T w, with v_c and w the time
-    derivatives of the forward kinematics along qd (no Jacobians)."""
+    """
+    Kinetic energy from time derivatives of the forward kinematics.
+
+    sum_j 1/2 m |v_c|^2 + 1/2 w^T R I R^T w, with v_c and w the time
+    derivatives of the forward kinematics along qd (no Jacobians).
+    """
     q = np.asarray(q, dtype=float)
     qd = np.asarray(qd, dtype=float)
     n = len(q)
@@ -287,8 +318,8 @@ def kinetic_energy(model, q, qd, method='complex'):
         c = np.asarray(model.com[j])
         vc = Tdot[j, :3, :3] @ c + Tdot[j, :3, 3]
         w = _vee(Tdot[j, :3, :3] @ R.T)
-        I = R @ np.asarray(model.inertia[j]) @ R.T
-        total += 0.5 * model.mass[j] * (vc @ vc) + 0.5 * (w @ I @ w)
+        inertia = R @ np.asarray(model.inertia[j]) @ R.T
+        total += 0.5 * model.mass[j] * (vc @ vc) + 0.5 * (w @ inertia @ w)
     return float(total)
 
 
@@ -299,9 +330,12 @@ def total_energy(model, q, qd, method='complex'):
 
 
 def energy_rate(model, q, qd, qdd):
-    """d/dt (T + U) along a motion through (q, qd) with acceleration qdd,
-    by one complex step of E = 1/2 qd^T D(q) qd + U(q) along
-    (q + t qd, qd + t qdd): exact to round-off."""
+    """
+    Return d/dt (T + U) along a motion through (q, qd) with acceleration qdd.
+
+    Computed by one complex step of E = 1/2 qd^T D(q) qd + U(q) along
+    (q + t qd, qd + t qdd): exact to round-off.
+    """
     q = np.asarray(q, dtype=float)
     n = len(q)
 

@@ -1,4 +1,19 @@
-"""Helpers for tests that run real ROS 2 processes on loopback DDS.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Helpers for tests that run real ROS 2 processes on loopback DDS.
 
 Each test module takes its own ROS_DOMAIN_ID; discovery stays on
 localhost.  The node under test runs as its own process through its
@@ -15,12 +30,13 @@ PARAMS_DIR = os.path.join(PACKAGE_DIR, 'config', 'params')
 
 
 def domain_id(offset):
-    """A domain id unique to this test run and module (1..100)."""
+    """Return a domain id unique to this test run and module (1..100)."""
     return 1 + (os.getpid() * 7 + offset) % 100
 
 
 def ros_env(domain):
-    """This process's environment with ROS traffic kept on loopback.
+    """
+    Return this process's environment with ROS traffic kept on loopback.
 
     LD_LIBRARY_PATH is inherited untouched (the ROS wheels' bootstrap set
     it; replacing it would break rclpy in the child).

@@ -1,4 +1,19 @@
-"""Dynamics checked by physics, not by snapshots of the library's output.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Dynamics checked by physics, not by snapshots of the library's output.
 
 Three kinds of evidence:
 
@@ -27,11 +42,8 @@ import os
 import sys
 import warnings
 
-import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-
 from newton_euler_ros.core import (bundled_robots, coriolis_matrix,
                                    end_effector_pose, forward_dynamics,
                                    gravity_torques, inverse_dynamics,
@@ -40,6 +52,8 @@ from newton_euler_ros.core import (bundled_robots, coriolis_matrix,
                                    mass_matrix, velocity_products,
                                    wrench_torques)
 from newton_euler_ros.core.model import convert_convention
+import numpy as np
+import pytest
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import reference_dynamics as ref  # noqa: E402
@@ -131,8 +145,11 @@ def random_pose(rng, reach=0.5):
 
 
 def random_inertia(rng):
-    """Random positive semidefinite inertia about the com (some rod-like
-    ones with a zero principal moment)."""
+    """
+    Return a random positive semidefinite inertia about the com.
+
+    About a third are rod-like, with a zero principal moment.
+    """
     if rng.uniform() < 0.3:
         p = rng.uniform(0.01, 0.2)
         moments = np.array([0.0, p, p])
@@ -180,7 +197,8 @@ def chain_states(seed, count=3):
 # 1. closed forms: Spong's planar elbow arm
 # ---------------------------------------------------------------------------
 def spong_2r(p, q, qd, qdd):
-    """Spong, Hutchinson & Vidyasagar, planar elbow arm, gravity -g y0.
+    """
+    Spong, Hutchinson & Vidyasagar, planar elbow arm, gravity -g y0.
 
     d11 = m1 lc1^2 + m2 (l1^2 + lc2^2 + 2 l1 lc2 c2) + I1 + I2
     d12 = m2 (lc2^2 + l1 lc2 c2) + I2,  d22 = m2 lc2^2 + I2
@@ -217,13 +235,17 @@ def spong_2r(p, q, qd, qdd):
     return D, C, G, J, tau
 
 
-SPONG = dict(m1=1.7, m2=0.9, l1=0.75, l2=0.55, lc1=0.31, lc2=0.26,
-             I1=0.041, I2=0.017, g=9.81)
+SPONG = {'m1': 1.7, 'm2': 0.9, 'l1': 0.75, 'l2': 0.55, 'lc1': 0.31,
+         'lc2': 0.26, 'I1': 0.041, 'I2': 0.017, 'g': 9.81}
 
 
 def two_r_standard(p):
-    """Standard DH: frame j at the distal end of link j, so the com at
-    distance lc from joint j is at x = lc - l in frame j."""
+    """
+    Build Spong's elbow arm with parameters ``p`` in standard DH.
+
+    Frame j is at the distal end of link j, so the com at distance lc from
+    joint j is at x = lc - l in frame j.
+    """
     return make_model(
         'elbow', 'standard', ['j1', 'j2'], [R, R], a=[p['l1'], p['l2']],
         alpha=[0, 0], d=[0, 0], theta=[0, 0], mass=[p['m1'], p['m2']],
@@ -234,9 +256,13 @@ def two_r_standard(p):
 
 
 def two_r_modified(p):
-    """Modified DH: frame j at joint j (com at x = lc), tip in the tool.
-    Mounted with the plane of motion vertical: base = Tz(0.4) Rx(pi/2), so
-    y0 is the base's z and gravity (0, 0, -g) is -g y0."""
+    """
+    Build Spong's elbow arm with parameters ``p`` in modified DH.
+
+    Frame j at joint j (com at x = lc), tip in the tool.  Mounted with the
+    plane of motion vertical: base = Tz(0.4) Rx(pi/2), so y0 is the base's
+    z and gravity (0, 0, -g) is -g y0.
+    """
     base = np.eye(4)
     base[:3, :3] = rot_x(math.pi / 2)
     base[:3, 3] = [0.1, -0.2, 0.4]
@@ -252,8 +278,12 @@ def two_r_modified(p):
 
 
 def params_of_bundled_2r(model):
-    """Spong's parameters read from planar_2r.yaml (standard DH, frames at
-    the distal ends, com on the x axis, gravity along -y0)."""
+    """
+    Read Spong's parameters from the model of planar_2r.yaml.
+
+    Asserts the layout they assume: standard DH, frames at the distal ends,
+    com on the x axis, gravity along -y0.
+    """
     assert model.convention == 'standard'
     assert model.joint_types == (R, R)
     assert np.all(model.alpha == 0) and np.all(model.d == 0)
@@ -263,10 +293,10 @@ def params_of_bundled_2r(model):
     assert np.array_equal(model.base, np.eye(4))
     assert np.array_equal(model.tool, np.eye(4))
     l1, l2 = model.a
-    return dict(m1=model.mass[0], m2=model.mass[1], l1=l1, l2=l2,
-                lc1=l1 + model.com[0, 0], lc2=l2 + model.com[1, 0],
-                I1=model.inertia[0][2, 2], I2=model.inertia[1][2, 2],
-                g=-model.gravity[1])
+    return {'m1': model.mass[0], 'm2': model.mass[1], 'l1': l1, 'l2': l2,
+            'lc1': l1 + model.com[0, 0], 'lc2': l2 + model.com[1, 0],
+            'I1': model.inertia[0][2, 2], 'I2': model.inertia[1][2, 2],
+            'g': -model.gravity[1]}
 
 
 TWO_R = {
@@ -323,7 +353,8 @@ def test_planar_2r_closed_form(variant):
 # 1b. closed forms: planar RP (polar) arm
 # ---------------------------------------------------------------------------
 def rp_closed_form(p, q, qd, qdd):
-    """Planar RP arm, derived by hand with Euler-Lagrange.
+    """
+    Planar RP arm, derived by hand with Euler-Lagrange.
 
     Joint 1: angle th about the normal to the plane; joint 2: radial
     extension r.  Link 1 (mass m1, planar inertia I1 about its com) has its
@@ -370,13 +401,18 @@ def rp_closed_form(p, q, qd, qdd):
     return D, C, G, J, tau
 
 
-RP = dict(m1=2.3, m2=1.1, lc1=0.27, e=-0.35, I1=0.07, I2=0.05, g=9.81)
+RP = {'m1': 2.3, 'm2': 1.1, 'lc1': 0.27, 'e': -0.35, 'I1': 0.07, 'I2': 0.05,
+      'g': 9.81}
 
 
 def rp_standard(p):
-    """Standard DH as in planar_rp.yaml: alpha1 = pi/2 and theta offset
-    pi/2 make z1 radial; frame 2 = frame 1 moved q2 along z1.  The normal to
-    the plane is y1 = y2 = z0, so the planar inertia is Iyy."""
+    """
+    Build the planar RP arm with parameters ``p`` in standard DH.
+
+    As in planar_rp.yaml: alpha1 = pi/2 and theta offset pi/2 make z1
+    radial; frame 2 = frame 1 moved q2 along z1.  The normal to the plane
+    is y1 = y2 = z0, so the planar inertia is Iyy.
+    """
     return make_model(
         'rp', 'standard', ['th', 'r'], [R, P], a=[0, 0],
         alpha=[math.pi / 2, 0], d=[0, 0], theta=[math.pi / 2, 0],
@@ -387,11 +423,15 @@ def rp_standard(p):
 
 
 def rp_modified(p):
-    """Modified DH built by hand: joint 1 (theta offset pi/2) about z0, so
-    x1 = (-sin th, cos th), y1 = -(cos th, sin th), z1 = z0; joint 2 has
-    alpha2 = pi/2, so z2 = Rx(pi/2) z = -y1 is radial and y2 = z1.  Link 1's
-    com (radial, lc1) is at -lc1 y1; the planar inertias are Izz of link 1
-    and Iyy of link 2."""
+    """
+    Build the planar RP arm with parameters ``p`` in modified DH, by hand.
+
+    Joint 1 (theta offset pi/2) about z0, so x1 = (-sin th, cos th),
+    y1 = -(cos th, sin th), z1 = z0; joint 2 has alpha2 = pi/2, so
+    z2 = Rx(pi/2) z = -y1 is radial and y2 = z1.  Link 1's com (radial,
+    lc1) is at -lc1 y1; the planar inertias are Izz of link 1 and Iyy of
+    link 2.
+    """
     return make_model(
         'rp_mdh', 'modified', ['th', 'r'], [R, P], a=[0, 0],
         alpha=[0, math.pi / 2], d=[0, 0], theta=[math.pi / 2, 0],
@@ -402,7 +442,7 @@ def rp_modified(p):
 
 
 def params_of_bundled_rp(model):
-    """The RP parameters read from planar_rp.yaml (see its header)."""
+    """Read the RP parameters from the model of planar_rp.yaml (see its header)."""
     assert model.convention == 'standard'
     assert model.joint_types == (R, P)
     assert model.alpha[0] == pytest.approx(math.pi / 2, abs=1e-15)
@@ -411,9 +451,9 @@ def params_of_bundled_rp(model):
     assert model.alpha[1] == 0 and model.theta[1] == 0
     assert np.all(model.com[:, :2] == 0)
     assert model.gravity[0] == 0 and model.gravity[2] == 0
-    return dict(m1=model.mass[0], m2=model.mass[1], lc1=model.com[0, 2],
-                e=model.com[1, 2], I1=model.inertia[0][1, 1],
-                I2=model.inertia[1][1, 1], g=-model.gravity[1])
+    return {'m1': model.mass[0], 'm2': model.mass[1], 'lc1': model.com[0, 2],
+            'e': model.com[1, 2], 'I1': model.inertia[0][1, 1],
+            'I2': model.inertia[1][1, 1], 'g': -model.gravity[1]}
 
 
 RP_VARIANTS = {
@@ -469,7 +509,8 @@ def test_bundled_planar_rp_tip_is_at_r_along_the_link():
 @pytest.mark.parametrize('convention', ['standard', 'modified_by_hand',
                                         'converted'])
 def test_prismatic_coriolis_is_2_m_r_rdot_thetadot(convention):
-    """A point mass m sliding outwards (rd) on an arm turning at thd.
+    """
+    A point mass m sliding outwards (rd) on an arm turning at thd.
 
     In the rotating frame the mass has radial velocity rd, so it needs the
     tangential Coriolis force 2 m rd thd (half from the change of direction
@@ -480,7 +521,8 @@ def test_prismatic_coriolis_is_2_m_r_rdot_thetadot(convention):
     -m r thd^2.  No gravity, no acceleration.
     """
     m, I_hub = 1.3, 0.2
-    p = dict(m1=0.0, m2=m, lc1=0.0, e=0.0, I1=I_hub, I2=0.0, g=0.0)
+    p = {'m1': 0.0, 'm2': m, 'lc1': 0.0, 'e': 0.0, 'I1': I_hub, 'I2': 0.0,
+         'g': 0.0}
     base = {'standard': rp_standard, 'modified_by_hand': rp_modified,
             'converted': lambda p: convert_convention(rp_standard(p),
                                                       'modified')}
@@ -547,9 +589,12 @@ def test_bundled_robot_against_euler_lagrange(name, convention):
 
 @pytest.mark.parametrize('name', BUNDLED)
 def test_convention_conversion_preserves_the_robot(name):
-    """Same end-effector pose and the same physics in both conventions,
-    judged by the oracle (so a conversion that produced a different but
-    self-consistent robot would fail here)."""
+    """
+    Same end-effector pose and the same physics in both conventions.
+
+    Judged by the oracle, so a conversion that produced a different but
+    self-consistent robot would fail here.
+    """
     std, mod = bundled(name, 'standard'), bundled(name, 'modified')
     rng = np.random.default_rng(31 + BUNDLED.index(name))
     for _ in range(3):
@@ -752,8 +797,8 @@ def test_batch_equals_single(convention):
 
 
 # hypothesis: a couple of properties over random chains
-CHAIN_ARGS = dict(seed=st.integers(0, 2 ** 31 - 1), n=st.integers(1, 6),
-                  convention=st.sampled_from(CONVENTIONS))
+CHAIN_ARGS = {'seed': st.integers(0, 2 ** 31 - 1), 'n': st.integers(1, 6),
+              'convention': st.sampled_from(CONVENTIONS)}
 
 
 @settings(max_examples=15, deadline=None, database=None, derandomize=True)
@@ -778,8 +823,11 @@ def test_property_passivity_and_christoffel_symmetry(seed, n, convention):
 @given(**CHAIN_ARGS)
 def test_property_kinetic_energy_and_positive_definiteness(seed, n,
                                                            convention):
-    """1/2 qd^T D qd equals the oracle's kinetic energy from the time
-    derivative of its FK, and D is positive definite."""
+    """
+    1/2 qd^T D qd equals the oracle's kinetic energy; D is positive definite.
+
+    The oracle takes the kinetic energy from the time derivative of its FK.
+    """
     rng = np.random.default_rng(seed)
     model = random_chain(rng, n, convention)
     q, qd, _, _ = random_state(rng, n)
@@ -810,9 +858,13 @@ def rk4(f, x, t0, dt, steps, every, observe):
 
 
 def simulate(model, q0, qd0, seconds, dt, torque=None, every=100):
-    """Integrate (q, qd, W) with qdd = forward_dynamics(q, qd, tau(t)) and
+    """
+    Integrate a motion by RK4 and record its energy balance.
+
+    Integrates (q, qd, W) with qdd = forward_dynamics(q, qd, tau(t)) and
     W' = qd^T tau(t) (the work of the actuators).  Returns the observed
-    (t, E(t) - E(0) - W(t), energy scale) from the oracle's energies."""
+    (t, E(t) - E(0) - W(t), energy scale) from the oracle's energies.
+    """
     n = model.n
     zero = np.zeros(n)
 
@@ -872,9 +924,12 @@ def test_free_motion_conserves_energy(case):
 
 
 def test_energy_drift_shrinks_like_dt4():
-    """The drift is integration error, not a modelling error: halving dt
-    divides it by ~16 (RK4).  Coarse steps so the drift is well above
-    round-off."""
+    """
+    The drift is integration error, not a modelling error.
+
+    Halving dt divides it by ~16 (RK4).  Coarse steps so the drift is well
+    above round-off.
+    """
     model, q0, qd0 = ENERGY_CASES['random5_modified']()
     drifts = []
     for dt in (2e-2, 1e-2):
@@ -888,8 +943,12 @@ def test_energy_drift_shrinks_like_dt4():
 
 
 def test_driven_motion_power_identity_integrated():
-    """d/dt (T + U) = qd^T tau: E(t) - E(0) = integral of qd^T tau dt for a
-    smooth torque, with the work integrated alongside the state."""
+    """
+    d/dt (T + U) = qd^T tau, integrated along a driven motion.
+
+    E(t) - E(0) = integral of qd^T tau dt for a smooth torque, with the
+    work integrated alongside the state.
+    """
     model = random_chain(np.random.default_rng(808), 4, 'standard',
                          [R, P, R, P])
     amp = np.array([6.0, 15.0, 3.0, 10.0])
@@ -911,12 +970,16 @@ def test_driven_motion_power_identity_integrated():
 
 @pytest.mark.parametrize('name', ['puma560', 'stanford', 'scara', 'panda'])
 def test_power_identity_pointwise(name):
-    """At a state: dE/dt along (qd, qdd) with qdd from forward_dynamics
-    equals qd^T tau - (J qd)^T F, the actuator power minus the power the
-    end effector delivers to the environment (F is exerted BY the end
-    effector).  dE/dt by a complex step of the oracle's energy (exact to
-    round-off; the accelerations reach 1e5 rad/s^2 on the Puma's light
-    wrist, where finite differences would need a step ~1e-5)."""
+    """
+    At a state, dE/dt = qd^T tau - (J qd)^T F.
+
+    dE/dt along (qd, qdd), with qdd from forward_dynamics, is the actuator
+    power minus the power the end effector delivers to the environment (F
+    is exerted BY the end effector).  dE/dt by a complex step of the
+    oracle's energy (exact to round-off; the accelerations reach 1e5
+    rad/s^2 on the Puma's light wrist, where finite differences would need
+    a step ~1e-5).
+    """
     model = bundled(name, 'standard')
     rng = np.random.default_rng(99 + BUNDLED.index(name))
     for _ in range(3):

@@ -1,18 +1,34 @@
-"""Bad input to the library raises DynamicsInputError naming the argument
-and the index; nothing non-finite comes out of finite input."""
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Bad input to the library raises DynamicsInputError naming argument and index.
+
+Nothing non-finite comes out of finite input.
+"""
 import doctest
 import math
 
-import numpy as np
-import pytest
-
-from newton_euler_ros.core import (DynamicsInputError, coriolis_matrix,
+from newton_euler_ros.core import (coriolis_matrix, DynamicsInputError,
                                    forward_dynamics, gravity_torques,
                                    inverse_dynamics, inverse_dynamics_batch,
                                    jacobian, load_robot, make_model,
                                    mass_matrix, NotPositiveDefiniteError,
                                    wrench_torques)
 from newton_euler_ros.core import dynamics, robot_file
+import numpy as np
+import pytest
 
 
 @pytest.fixture(scope='module')

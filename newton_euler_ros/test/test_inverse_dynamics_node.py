@@ -1,4 +1,19 @@
-"""inverse_dynamics_node as a real process on loopback DDS.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+inverse_dynamics_node as a real process on loopback DDS.
 
 The node starts through its console script with a bundled parameter file;
 this process publishes joint states and wrenches, collects the outputs and
@@ -16,17 +31,17 @@ import pytest
 
 pytest.importorskip('rclpy')
 
-from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+# After the skip: pytest must be imported first, hence E402 and I100.
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
 from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
-from sensor_msgs.msg import JointState  # noqa: E402
-from std_msgs.msg import Float64MultiArray  # noqa: E402
-
-from newton_euler_ros.core import (coriolis_matrix, gravity_torques,  # noqa
+from newton_euler_ros.core import (coriolis_matrix, gravity_torques,  # noqa: E402
                                    inverse_dynamics, load_robot,
                                    mass_matrix)
-from ros_harness import (PARAMS_DIR, NodeProcess, Probe, domain_id,  # noqa
+from ros_harness import (domain_id, NodeProcess, PARAMS_DIR, Probe,  # noqa: E402
                          ros_env)
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import Float64MultiArray  # noqa: E402
 
 pytestmark = pytest.mark.ros
 
@@ -86,8 +101,11 @@ class Graph:
 
     def send_state(self, q, qd, names=None, position=None, velocity=None,
                    wait=5.0):
-        """Publish a joint state in shuffled order with an extra joint;
-        return (torque_command data, torques msg) or None if no output."""
+        """
+        Publish a joint state in shuffled order with an extra joint.
+
+        Return (torque_command data, torques msg), or None if no output.
+        """
         self.seq += 1
         msg = JointState()
         stamp = self.now().to_msg()
@@ -221,26 +239,27 @@ def bad_requests(model):
         'missing joints'
     yield ComputeDynamics.Request(name=names, position=[0.0] * 5), \
         'position has 5 entries for 6 names'
-    yield ComputeDynamics.Request(name=names, position=[0.0] * 5 + [math.nan]
-                                  ), 'position of'
+    yield ComputeDynamics.Request(
+        name=names, position=[0.0] * 5 + [math.nan]), 'position of'
     yield ComputeDynamics.Request(name=names, position=[0.0] * 6,
                                   velocity=[math.inf] * 6), 'velocity of'
     yield ComputeDynamics.Request(name=names + ['joint1'],
                                   position=[0.0] * 7), 'appears twice'
 
 
-def test_bad_input_publishes_nothing_and_good_input_still_works(graph,
-                                                                  model):
+def test_bad_input_publishes_nothing_and_good_input_still_works(graph, model):
     q, qd = STATES[1]
     before = graph.counters()
     names6 = [f'joint{k}' for k in range(1, 7)]
     bad_states = [
-        dict(names=names6[:5], position=list(q[:5]), velocity=list(qd[:5])),
-        dict(names=names6, position=[*q[:5], math.nan], velocity=list(qd)),
-        dict(names=names6, position=list(q), velocity=[math.inf] * 6),
-        dict(names=names6, position=list(q[:5]), velocity=list(qd)),
-        dict(names=names6 + ['joint2'], position=[*q, 0.0],
-             velocity=[*qd, 0.0]),
+        {'names': names6[:5], 'position': list(q[:5]),
+         'velocity': list(qd[:5])},
+        {'names': names6, 'position': [*q[:5], math.nan],
+         'velocity': list(qd)},
+        {'names': names6, 'position': list(q), 'velocity': [math.inf] * 6},
+        {'names': names6, 'position': list(q[:5]), 'velocity': list(qd)},
+        {'names': names6 + ['joint2'], 'position': [*q, 0.0],
+         'velocity': [*qd, 0.0]},
     ]
     for bad in bad_states:
         assert graph.send_state(q, qd, wait=0.5, **bad) is None
@@ -281,8 +300,8 @@ def test_stops_cleanly(graph):
 
 
 @pytest.mark.parametrize('args, message', [
-    (['-p', 'robot_file:=no_such_robot'], 'robot_file: no_such_robot: no '
-                                         'such file'),
+    (['-p', 'robot_file:=no_such_robot'],
+     'robot_file: no_such_robot: no such file'),
     (['-p', 'joints:=[joint1, joint2]'], 'joints: must name every joint'),
     (['-p', 'wrench.convention:=pushing'], 'wrench.convention: must be one '
                                            'of'),

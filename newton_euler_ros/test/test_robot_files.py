@@ -1,15 +1,32 @@
-"""Robot files: the bundled ones load, bad ones fail with the promised
-messages (file, link, field), numbers written by people are coerced."""
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Robot files: the bundled ones load, bad ones fail with the promised messages.
+
+Error messages name the file, the link and the field; numbers written by
+people are coerced.
+"""
 import math
 import warnings
 
+from newton_euler_ros.core import (bundled_robots, load_robot, RobotFileError,
+                                   RobotFileWarning)
+from newton_euler_ros.core.robot_file import inspect_robot
 import numpy as np
 import pytest
 import yaml
-
-from newton_euler_ros.core import (RobotFileError, RobotFileWarning,
-                                   bundled_robots, load_robot)
-from newton_euler_ros.core.robot_file import inspect_robot
 
 BUNDLED = ['panda', 'planar_2r', 'planar_rp', 'puma560', 'scara', 'stanford']
 
@@ -57,9 +74,9 @@ def test_bundled_robot_loads_with_physical_parameters(name):
         model = load_robot(name)
     assert model.n == len(set(model.joint_names))
     assert np.all(model.mass >= 0.0)
-    for I in model.inertia:
-        assert np.allclose(I, I.T)
-        assert np.linalg.eigvalsh(I).min() >= -1e-15
+    for inertia in model.inertia:
+        assert np.allclose(inertia, inertia.T)
+        assert np.linalg.eigvalsh(inertia).min() >= -1e-15
     assert np.isfinite(model.links_array).all()
 
 
@@ -103,8 +120,8 @@ def test_full_3x3_inertia_accepted(tmp_path):
 
 
 BAD = [
-    (variant(mass=-1.0), r"robot\.yaml: links\[1\] \(slide\): mass: must be "
-                         r">= 0, got -1\.0"),
+    (variant(mass=-1.0), r'robot\.yaml: links\[1\] \(slide\): mass: must be '
+                         r'>= 0, got -1\.0'),
     (variant(mass='heavy'), r'links\[1\] \(slide\): mass: must be a number'),
     (variant(mass='nan'), r'links\[1\] \(slide\): mass: must be finite'),
     (variant(mass=float('inf')), r'mass: must be finite'),
@@ -119,11 +136,11 @@ BAD = [
      r'inertia: must be symmetric'),
     (variant(type='spherical'), r"type: must be 'revolute' or 'prismatic', "
                                 r"got 'spherical'"),
-    (variant(mass=None), r"links\[1\] \(slide\): missing required key "
+    (variant(mass=None), r'links\[1\] \(slide\): missing required key '
                          r"'mass'"),
     (variant(colour='red'), r"links\[1\] \(slide\): unknown key 'colour'"),
     (variant(name='shoulder'), r"name: 'shoulder' is used by an earlier "
-                               r"link"),
+                               r'link'),
     (variant(limits={'lower': 1.0, 'upper': 0.0}),
      r'limits: lower \(1\.0\) is above upper \(0\.0\)'),
     (variant(limits={'velocity': 0.0}), r'limits\.velocity: must be > 0'),

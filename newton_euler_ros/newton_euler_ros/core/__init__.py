@@ -1,17 +1,33 @@
-"""Pure numpy/numba core: robot model, kinematics and dynamics (no ROS).
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Pure numpy/numba core: robot model, kinematics and dynamics (no ROS).
 
 See :mod:`newton_euler_ros.core.dynamics` for the functions, one per term
 of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``.
 """
-from .dynamics import (Workspace, coriolis_matrix, end_effector_pose,
-                       forward_dynamics, gravity_torques, inverse_dynamics,
+from .dynamics import (coriolis_matrix, end_effector_pose, forward_dynamics,
+                       gravity_torques, inverse_dynamics,
                        inverse_dynamics_batch, jacobian, link_poses,
-                       mass_matrix, velocity_products, wrench_torques)
+                       mass_matrix, velocity_products, Workspace,
+                       wrench_torques)
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
-from .model import RobotModel, make_model, pose_matrix, rpy_matrix
-from .robot_file import (RobotFileWarning, bundled_robots, inspect_robot,
-                         load_robot, robot_from_dict)
+from .model import make_model, pose_matrix, RobotModel, rpy_matrix
+from .robot_file import (bundled_robots, inspect_robot, load_robot,
+                         robot_from_dict, RobotFileWarning)
 
 __all__ = [
     'DynamicsInputError', 'NewtonEulerError', 'NotPositiveDefiniteError',

@@ -1,4 +1,19 @@
-"""Compiled kernels: the one Newton-Euler recursion and the kinematics it needs.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Compiled kernels: the one Newton-Euler recursion and the kinematics it needs.
 
 Everything here is scalar code over 3-tuples so that numba compiles it to
 tight machine code, and so that the very same source can run in plain
@@ -167,22 +182,36 @@ def _frame_rot(frames, row):
 @njit(cache=True)
 def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
               wrench_mode, ws, tau):
-    """Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
+    """
+    Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
 
     ``joint_trig(links, q, ws)`` must have been called for the same q.
+    Cost: about 330 flops per joint, O(n).
 
     Parameters
     ----------
-    qd, v, qdd : (n,) joint velocity, reference velocity, acceleration.
-    wrench : (6,) [f; n] exerted by the end effector on its environment,
-        moment about the end-effector origin; base-frame axes when
+    links : (n, L_WIDTH) array
+        Per-joint DH, mass, centre-of-mass and inertia parameters (the
+        ``L_*`` columns).
+    frames : (3, 12) array
+        Base frame, tool frame and gravity (the ``F_*`` rows).
+    qd, v, qdd : (n,) arrays
+        Joint velocity, reference velocity, acceleration.
+    wrench : (6,) array
+        [f; n] exerted by the end effector on its environment, moment about
+        the end-effector origin; base-frame axes when
         ``wrench_mode == WRENCH_BASE``, end-effector axes when
         ``WRENCH_EE``; ignored when ``WRENCH_NONE``.
-    gravity_on, velocity_on : skip the gravity or velocity-product terms
-        altogether when False.
-    tau : (n,) output.
+    gravity_on, velocity_on : bool
+        Skip the gravity or velocity-product terms altogether when False.
+    wrench_mode : int
+        ``WRENCH_NONE``, ``WRENCH_BASE`` or ``WRENCH_EE``.
+    ws : (n, W_WIDTH) array
+        Workspace: reads the trig columns ``joint_trig`` filled, overwrites
+        the other ``W_*`` columns.
+    tau : (n,) array
+        Output.
 
-    Cost: about 330 flops per joint, O(n).
     """
     n = links.shape[0]
     zero = 0.0 * ws[0, W_CT]
@@ -258,16 +287,13 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         ws[j, W_F + 1] = m * ac[1]
         ws[j, W_F + 2] = m * ac[2]
         # Euler's equation about the com
-        I = L_INERTIA
-        Ia = _rot((links[j, I], links[j, I + 1], links[j, I + 2],
-                   links[j, I + 3], links[j, I + 4], links[j, I + 5],
-                   links[j, I + 6], links[j, I + 7], links[j, I + 8]),
-                  al[0], al[1], al[2])
+        k = L_INERTIA
+        Ic = (links[j, k], links[j, k + 1], links[j, k + 2],
+              links[j, k + 3], links[j, k + 4], links[j, k + 5],
+              links[j, k + 6], links[j, k + 7], links[j, k + 8])
+        Ia = _rot(Ic, al[0], al[1], al[2])
         Nn = Ia
         if velocity_on:
-            Ic = (links[j, I], links[j, I + 1], links[j, I + 2],
-                  links[j, I + 3], links[j, I + 4], links[j, I + 5],
-                  links[j, I + 6], links[j, I + 7], links[j, I + 8])
             Ir = _rot(Ic, r[0], r[1], r[2])
             Iw = _rot(Ic, w[0], w[1], w[2])
             t = _cross(w[0], w[1], w[2], Ir[0], Ir[1], Ir[2])
@@ -370,7 +396,8 @@ def check_finite(q, qd, qdd, wrench):
 @njit(cache=True)
 def inverse_dynamics(links, frames, q, qd, qdd, wrench, gravity_on,
                      velocity_on, wrench_mode, ws, tau):
-    """tau(q, qd, qdd, F_e) after checking the inputs are finite.
+    """
+    tau(q, qd, qdd, F_e) after checking the inputs are finite.
 
     Returns -1, or the code of the first non-finite input (see
     ``check_finite``); tau is untouched then.
@@ -395,13 +422,14 @@ def inverse_dynamics_batch(links, frames, Q, QD, QDD, W, gravity_on,
 
 
 @njit(cache=True)
-def mass_matrix(links, frames, q, ws, scratch, D):
-    """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k).
+def _unit_columns(links, frames, qd, coriolis, ws, scratch, M):
+    """Columns of D (``coriolis`` False) or C(q, qd) from unit inputs.
 
+    D e_k = Y(q, 0, 0, e_k) and C e_k = Y(q, qd, e_k, 0), where Y is the
+    two-stream recursion; ``joint_trig`` must have been called for q.
     ``scratch`` is a (3, n) array.  Cost: n recursions, O(n^2).
     """
     n = links.shape[0]
-    joint_trig(links, q, ws)
     zero = scratch[0]
     unit = scratch[1]
     col = scratch[2]
@@ -410,11 +438,23 @@ def mass_matrix(links, frames, q, ws, scratch, D):
         unit[i] = 0.0
     for k in range(n):
         unit[k] = 1.0
-        recursion(links, frames, zero, zero, unit, zero, False, False,
-                  WRENCH_NONE, ws, col)
+        if coriolis:
+            recursion(links, frames, qd, unit, zero, zero, False, True,
+                      WRENCH_NONE, ws, col)
+        else:
+            recursion(links, frames, zero, zero, unit, zero, False, False,
+                      WRENCH_NONE, ws, col)
         unit[k] = 0.0
         for i in range(n):
-            D[i, k] = col[i]
+            M[i, k] = col[i]
+
+
+@njit(cache=True)
+def mass_matrix(links, frames, q, ws, scratch, D):
+    """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k)."""
+    n = links.shape[0]
+    joint_trig(links, q, ws)
+    _unit_columns(links, frames, q, False, ws, scratch, D)
     # D is symmetric in exact arithmetic; make it so to the last bit.
     for i in range(n):
         for k in range(i + 1, n):
@@ -426,26 +466,14 @@ def mass_matrix(links, frames, q, ws, scratch, D):
 @njit(cache=True)
 def coriolis_matrix(links, frames, q, qd, ws, scratch, C):
     """Christoffel C(q, qd) column by column: C e_k = Y(q, qd, e_k, 0)."""
-    n = links.shape[0]
     joint_trig(links, q, ws)
-    zero = scratch[0]
-    unit = scratch[1]
-    col = scratch[2]
-    for i in range(n):
-        zero[i] = 0.0
-        unit[i] = 0.0
-    for k in range(n):
-        unit[k] = 1.0
-        recursion(links, frames, qd, unit, zero, zero, False, True,
-                  WRENCH_NONE, ws, col)
-        unit[k] = 0.0
-        for i in range(n):
-            C[i, k] = col[i]
+    _unit_columns(links, frames, qd, True, ws, scratch, C)
 
 
 @njit(cache=True)
 def forward_kinematics(links, frames, q, ws, Ts):
-    """Poses of frames 0..n and of the end effector in the base frame.
+    """
+    Poses of frames 0..n and of the end effector in the base frame.
 
     ``Ts`` is (n + 2, 12): rows 0..n the link frames, row n+1 the end
     effector; each row R (9, row-major) then p (3).
@@ -475,7 +503,8 @@ def forward_kinematics(links, frames, q, ws, Ts):
 
 @njit(cache=True)
 def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
-    """Geometric Jacobian of the end-effector origin, rows [v; w].
+    """
+    Geometric Jacobian of the end-effector origin, rows [v; w].
 
     Base-frame axes, or end-effector axes when ``in_ee_axes``.  Cost O(n).
     """
@@ -512,7 +541,8 @@ def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
 
 @njit(cache=True)
 def cholesky_solve(A, b, L, x):
-    """Solve A x = b for symmetric positive definite A by Cholesky.
+    """
+    Solve A x = b for symmetric positive definite A by Cholesky.
 
     Returns -1 on success, or the index of the first pivot that is not
     positive (A is not positive definite there).  A is left unchanged.

@@ -1,4 +1,21 @@
-"""Rigid-body dynamics of a serial chain, one function per term of
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Rigid-body dynamics of a serial chain, one function per equation term.
+
+The equation of motion is
 
     D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau        (seed eq. 23)
 
@@ -30,6 +47,7 @@ Examples
 >>> tau = inverse_dynamics(arm, [0.0, 0.0])     # at rest: gravity only
 >>> bool(abs(tau[1] - gravity_torques(arm, [0.0, 0.0])[1]) < 1e-15)
 True
+
 """
 import weakref
 
@@ -43,7 +61,8 @@ _ARG_NAMES = ('q', 'qd', 'qdd', 'wrench')
 
 
 class Workspace:
-    """Preallocated scratch memory for one model; reuse it across calls.
+    """
+    Preallocated scratch memory for one model; reuse it across calls.
 
     Not thread-safe: give each thread its own.  Every dynamics function
     takes ``ws=``; without it, a workspace cached on the model is used.
@@ -72,7 +91,7 @@ def _default_ws(model):
 
 
 def _vector(name, x, size):
-    """x as a contiguous float64 vector of the given size, or raise."""
+    """Return x as a contiguous float64 vector of the given size, or raise."""
     if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1
             and x.flags.c_contiguous):
         arr = x
@@ -113,31 +132,41 @@ def _wrench_args(wrench, wrench_frame, ws):
     except KeyError:
         raise DynamicsInputError(
             f"wrench_frame must be 'base' or 'end_effector', "
-            f"got {wrench_frame!r}") from None
+            f'got {wrench_frame!r}') from None
     return _vector('wrench', wrench, 6), mode
 
 
 def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
                      wrench_frame='base', *, gravity=True,
                      velocity_products=True, ws=None, out=None):
-    """Joint forces tau = D qdd + C qd + g + J^T F_e, by Newton-Euler.
+    """
+    Joint forces tau = D qdd + C qd + g + J^T F_e, by Newton-Euler.
+
+    Cost: one forward and one backward pass, O(n).
 
     Parameters
     ----------
     model : RobotModel
-    q, qd, qdd : (n,) joint positions, velocities, accelerations (rad or
-        m, and their rates); ``None`` means zeros.
-    wrench : (6,) or None.  [f; n], N and N m, exerted by the end effector.
-    wrench_frame : ``'base'`` or ``'end_effector'`` axes of ``wrench``.
-    gravity, velocity_products : set False to leave that term out (it is
-        then not computed at all).
-    ws : Workspace, optional.  out : (n,) array to write tau into.
+        The robot.
+    q, qd, qdd : (n,) array_like
+        Joint positions, velocities, accelerations (rad or m, and their
+        rates); ``None`` (the default for qd and qdd) means zeros.
+    wrench : (6,) array_like or None
+        [f; n], N and N m, exerted by the end effector.
+    wrench_frame : str
+        ``'base'`` or ``'end_effector'``: the axes of ``wrench``.
+    gravity, velocity_products : bool
+        Set False to leave that term out (it is then not computed at all).
+    ws : Workspace, optional
+        Scratch memory; without it, the workspace cached on the model.
+    out : (n,) array, optional
+        Array to write tau into.
 
     Returns
     -------
-    (n,) float64, N m for revolute and N for prismatic joints.
+    (n,) float64
+        N m for revolute and N for prismatic joints.
 
-    Cost: one forward and one backward pass, O(n).
     """
     ws = ws or _default_ws(model)
     n = ws.n
@@ -157,7 +186,8 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
 def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
                            wrench_frame='base', *, gravity=True,
                            velocity_products=True, ws=None, out=None):
-    """:func:`inverse_dynamics` for each row of (m, n) arrays of states.
+    """
+    :func:`inverse_dynamics` for each row of (m, n) arrays of states.
 
     ``W`` is an (m, 6) array of wrenches or None.  Returns (m, n).  One
     compiled loop: no Python work per state.
@@ -175,7 +205,7 @@ def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
         if mode is None:
             raise DynamicsInputError(
                 f"wrench_frame must be 'base' or 'end_effector', "
-                f"got {wrench_frame!r}")
+                f'got {wrench_frame!r}')
     for name, X in (('Q', Q), ('QD', QD), ('QDD', QDD), ('W', W)):
         bad = np.argwhere(~np.isfinite(X))
         if bad.size:
@@ -203,7 +233,8 @@ def _matrix(name, X, cols, rows=None):
 
 
 def mass_matrix(model, q, *, ws=None, out=None):
-    """Joint-space inertia matrix D(q), (n, n), symmetric positive definite.
+    """
+    Joint-space inertia matrix D(q), (n, n), symmetric positive definite.
 
     Column k is the Newton-Euler torque for qdd = e_k with no velocity and
     no gravity.  Cost: n recursions, O(n^2).
@@ -218,7 +249,8 @@ def mass_matrix(model, q, *, ws=None, out=None):
 
 
 def coriolis_matrix(model, q, qd, *, ws=None, out=None):
-    """Coriolis/centrifugal matrix C(q, qd) built from Christoffel symbols.
+    """
+    Coriolis/centrifugal matrix C(q, qd) built from Christoffel symbols.
 
     ``C[k, j] = sum_i c_ijk qd_i`` with
     ``c_ijk = (dD_kj/dq_i + dD_ki/dq_j - dD_ij/dq_k) / 2``, so that
@@ -248,7 +280,8 @@ def gravity_torques(model, q, *, ws=None, out=None):
 
 
 def jacobian(model, q, frame='base', *, ws=None, out=None):
-    """Geometric Jacobian J(q), (6, n), of the end-effector origin.
+    """
+    Geometric Jacobian J(q), (6, n), of the end-effector origin.
 
     Rows are [linear velocity; angular velocity] such that
     ``[v; w] = J(q) qd``, in base-frame axes (``frame='base'``) or
@@ -267,7 +300,8 @@ def jacobian(model, q, frame='base', *, ws=None, out=None):
 
 
 def wrench_torques(model, q, wrench, wrench_frame='base', *, ws=None):
-    """J(q)^T F_e: the joint forces that balance an end-effector wrench.
+    """
+    J(q)^T F_e: the joint forces that balance an end-effector wrench.
 
     Computed from the Jacobian (virtual work); :func:`inverse_dynamics`
     applies the same wrench as f_{n+1}, tau_{n+1} in its backward pass, and
@@ -294,8 +328,11 @@ def end_effector_pose(model, q, *, ws=None):
 
 
 def link_poses(model, q, *, ws=None):
-    """(n + 2, 4, 4) poses of frames 0..n and the end effector in the base
-    frame."""
+    """
+    Poses of frames 0..n and of the end effector in the base frame.
+
+    Returns an (n + 2, 4, 4) array of homogeneous transforms.
+    """
     ws = ws or _default_ws(model)
     q = _vector('q', q, ws.n)
     _check_finite(q, ws.zeros, ws.zeros, ws.zero_wrench)
@@ -310,7 +347,8 @@ def link_poses(model, q, *, ws=None):
 
 def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                      gravity=True, velocity_products=True, ws=None):
-    """Joint accelerations: solve D(q) qdd = tau - C qd - g - J^T F_e.
+    """
+    Joint accelerations: solve D(q) qdd = tau - C qd - g - J^T F_e.
 
     Uses a Cholesky factorisation of D, never an explicit inverse.  Raises
     :class:`NotPositiveDefiniteError` naming the joint where D is not

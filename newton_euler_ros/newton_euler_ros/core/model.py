@@ -1,4 +1,19 @@
-"""The constant robot model: a serial chain in Denavit-Hartenberg form.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The constant robot model: a serial chain in Denavit-Hartenberg form.
 
 A :class:`RobotModel` is immutable after construction (its arrays are
 read-only).  Per-call scratch memory lives in a separate
@@ -54,7 +69,8 @@ def _readonly(x):
 
 @dataclass(frozen=True, eq=False)
 class RobotModel:
-    """A serial manipulator: DH table, inertial parameters, gravity, frames.
+    """
+    A serial manipulator: DH table, inertial parameters, gravity, frames.
 
     Build one with :func:`make_model` or
     :func:`newton_euler_ros.core.robot_file.load_robot`.
@@ -75,6 +91,7 @@ class RobotModel:
     tool : (4, 4) pose of the end-effector frame in link frame n
     limits : tuple of n dicts (keys among lower, upper, velocity, effort)
     links_array, frames_array : packed, read-only copies for the kernels
+
     """
 
     name: str
@@ -119,7 +136,7 @@ class RobotModel:
 
     @property
     def n(self):
-        """Number of joints (degrees of freedom)."""
+        """Return the number of joints (degrees of freedom)."""
         return len(self.joint_names)
 
     @property
@@ -128,7 +145,7 @@ class RobotModel:
         return float(self.mass.sum())
 
     def replace(self, **changes):
-        """A copy with some fields changed (e.g. ``gravity=[0, 0, 0]``)."""
+        """Return a copy with some fields changed (e.g. ``gravity=[0, 0, 0]``)."""
         fields = {k: getattr(self, k) for k in (
             'name', 'convention', 'joint_names', 'joint_types', 'a', 'alpha',
             'd', 'theta', 'mass', 'com', 'inertia', 'gravity', 'base',
@@ -140,16 +157,20 @@ class RobotModel:
 def make_model(name, convention, joint_names, joint_types, a, alpha, d,
                theta, mass, com, inertia, gravity=(0.0, 0.0, -9.81),
                base=None, tool=None, limits=None):
-    """Build a :class:`RobotModel` from plain sequences (no validation of
-    physical plausibility; :func:`load_robot` does that for files)."""
+    """
+    Build a :class:`RobotModel` from plain sequences.
+
+    No validation of physical plausibility: :func:`load_robot` does that for
+    files.
+    """
     n = len(joint_names)
     if convention not in (STANDARD, MODIFIED):
         raise ValueError(f"convention must be 'standard' or 'modified', "
-                         f"got {convention!r}")
+                         f'got {convention!r}')
     for t in joint_types:
         if t not in (REVOLUTE, PRISMATIC):
             raise ValueError(f"joint type must be 'revolute' or 'prismatic', "
-                             f"got {t!r}")
+                             f'got {t!r}')
     return RobotModel(
         name=str(name), convention=convention,
         joint_names=tuple(str(x) for x in joint_names),
@@ -162,8 +183,8 @@ def make_model(name, convention, joint_names, joint_types, a, alpha, d,
         gravity=_readonly(np.reshape(gravity, 3)),
         base=_readonly(np.eye(4) if base is None else base),
         tool=_readonly(np.eye(4) if tool is None else tool),
-        limits=tuple(limits) if limits is not None else tuple({} for _ in
-                                                             range(n)))
+        limits=(tuple(limits) if limits is not None
+                else tuple({} for _ in range(n))))
 
 
 def inertia_matrix(ixx, iyy, izz, ixy, iyz, ixz):
@@ -180,7 +201,8 @@ def _tx_rx(a, alpha):
 
 
 def convert_convention(model, convention):
-    """The same robot written in the other DH convention.
+    """
+    Return the same robot written in the given DH convention.
 
     The chain ``Rz Tz Tx Rx | Rz Tz Tx Rx | ...`` (standard) regroups as
     ``Rz Tz | Tx Rx Rz Tz | ... | Tx Rx`` (modified): modified link frame j
@@ -225,4 +247,3 @@ def convert_convention(model, convention):
                          f'got {convention!r}')
     return model.replace(convention=convention, a=a, alpha=alpha, com=com,
                          inertia=inertia, base=base, tool=tool)
-

@@ -1,4 +1,19 @@
-"""Robot description files (YAML): loading, validation, bundled robots.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Robot description files (YAML): loading, validation, bundled robots.
 
 The format is documented in the README ("Robot files").  Every error is a
 :class:`RobotFileError` whose message names the file, the link and the
@@ -17,8 +32,8 @@ import numpy as np
 import yaml
 
 from .errors import RobotFileError
-from .model import (MODIFIED, PRISMATIC, REVOLUTE, STANDARD, inertia_matrix,
-                    make_model, pose_matrix)
+from .model import (inertia_matrix, make_model, MODIFIED, pose_matrix,
+                    PRISMATIC, REVOLUTE, STANDARD)
 
 TOP_KEYS = {'name', 'description', 'source', 'convention', 'gravity', 'base',
             'tool', 'links'}
@@ -54,7 +69,7 @@ def bundled_robots():
 
 
 def resolve_robot_path(name_or_path):
-    """A path to an existing file, or a bundled robot's name -> its path."""
+    """Return the path of an existing file, or of the bundled robot so named."""
     path = os.fspath(name_or_path)
     if os.path.isfile(path):
         return path
@@ -127,7 +142,7 @@ def _eval_expr(node):
 
 
 def to_number(value, where):
-    """A finite float from a YAML value, or a RobotFileError naming where."""
+    """Return a finite float from a YAML value; raise RobotFileError naming where."""
     if isinstance(value, bool) or value is None:
         raise RobotFileError(f'{where}: must be a number, got {value!r}')
     if isinstance(value, (int, float)):
@@ -154,7 +169,7 @@ def to_number(value, where):
 
 
 def to_vector(value, size, where):
-    """A list of ``size`` finite floats."""
+    """Return a YAML list of ``size`` numbers as a list of finite floats."""
     if not isinstance(value, (list, tuple)):
         raise RobotFileError(
             f'{where}: must be a list of {size} numbers, got {value!r}')
@@ -185,20 +200,20 @@ def _inertia(value, where):
     if isinstance(value, (list, tuple)) and len(value) == 3 and all(
             isinstance(r, (list, tuple)) for r in value):
         rows = [to_vector(r, 3, f'{where}[{i}]') for i, r in enumerate(value)]
-        I = np.array(rows)
-        scale = max(np.abs(I).max(), 1e-300)
-        if np.abs(I - I.T).max() > 1e-12 * scale:
+        inertia = np.array(rows)
+        scale = max(np.abs(inertia).max(), 1e-300)
+        if np.abs(inertia - inertia.T).max() > 1e-12 * scale:
             raise RobotFileError(f'{where}: must be symmetric, got {rows}')
-        I = 0.5 * (I + I.T)
+        inertia = 0.5 * (inertia + inertia.T)
     else:
-        I = inertia_matrix(*to_vector(value, 6, where))
-    eig = np.linalg.eigvalsh(I)
-    scale = max(np.abs(I).max(), 1e-300)
+        inertia = inertia_matrix(*to_vector(value, 6, where))
+    eig = np.linalg.eigvalsh(inertia)
+    scale = max(np.abs(inertia).max(), 1e-300)
     if eig[0] < -1e-12 * scale:
         raise RobotFileError(
             f'{where}: must be positive semidefinite (principal moments '
             f'{", ".join(f"{e:.6g}" for e in eig)})')
-    return I, eig
+    return inertia, eig
 
 
 def _limits(data, where):
@@ -216,7 +231,8 @@ def _limits(data, where):
 
 
 def robot_from_dict(data, origin='<robot>'):
-    """Validate a parsed robot description; return (model, warnings).
+    """
+    Validate a parsed robot description; return (model, warnings).
 
     ``origin`` (usually the file name) starts every error message.
     """
@@ -273,8 +289,8 @@ def robot_from_dict(data, origin='<robot>'):
         cols['mass'].append(mass)
         com = to_vector(link['com'], 3, f'{where}: com')
         cols['com'].append(com)
-        I, eig = _inertia(link['inertia'], f'{where}: inertia')
-        cols['inertia'].append(I)
+        inertia, eig = _inertia(link['inertia'], f'{where}: inertia')
+        cols['inertia'].append(inertia)
         tol = 1e-9 * max(eig[2], 1e-300)
         if eig[0] + eig[1] < eig[2] - tol:
             found.append(
@@ -301,7 +317,8 @@ def inspect_robot(name_or_path):
 
 
 def load_robot(name_or_path):
-    """Load a robot file (a path, or a bundled name such as ``'puma560'``).
+    """
+    Load a robot file (a path, or a bundled name such as ``'puma560'``).
 
     Warnings (e.g. inertias that break the triangle inequality) are issued
     as :class:`RobotFileWarning`; errors raise :class:`RobotFileError`.

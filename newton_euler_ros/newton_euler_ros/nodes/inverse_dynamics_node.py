@@ -1,4 +1,19 @@
-"""inverse_dynamics_node: joint states (and a wrench) in, torques out.
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
 result is published.  See the README ("ROS 2 node") for the interface.
@@ -19,17 +34,17 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
+from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 import rclpy
 from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
-from ..core import NewtonEulerError, inspect_robot
+from ..core import inspect_robot, NewtonEulerError
 from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
                            ReferenceTrajectory, WrenchInput)
 from ..parameters import load_specs, validate
