@@ -313,3 +313,42 @@ def test_bad_parameters_refuse_to_start(tmp_path, args, message):
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr
     assert 'Traceback' not in proc.stderr
+
+
+def test_reference_accelerations_enter_the_torques(tmp_path, model):
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+    domain = domain_id(37)
+    node = NodeProcess(node_cmd('-p', 'acceleration_source:=reference'),
+                       domain, str(tmp_path / 'node.log'))
+    probe = Probe(domain)
+    try:
+        probe.call(ComputeDynamics, f'{NODE}/compute_dynamics',
+                   ComputeDynamics.Request(), timeout=90.0)
+        torques = probe.collect(JointState, f'{NODE}/torques')
+        js = probe.publisher(JointState, 'joint_states')
+        ref = probe.publisher(JointTrajectory, f'{NODE}/reference')
+        assert probe.spin_until(
+            lambda: js.get_subscription_count() > 0
+            and ref.get_subscription_count() > 0
+            and probe.node.count_publishers(f'{NODE}/torques') > 0, 20.0)
+        q, qd = STATES[2]
+        qdd = np.linspace(-1.0, 1.0, 6)
+        traj = JointTrajectory()
+        traj.joint_names = list(reversed(model.joint_names))
+        point = JointTrajectoryPoint()
+        point.accelerations = list(reversed(qdd.tolist()))
+        traj.points = [point]           # one point: held for all time
+        ref.publish(traj)
+        probe.spin_for(0.3)
+        msg = JointState()
+        msg.header.stamp = probe.node.get_clock().now().to_msg()
+        msg.name = list(model.joint_names)
+        msg.position, msg.velocity = q.tolist(), qd.tolist()
+        js.publish(msg)
+        assert probe.spin_until(lambda: torques, 5.0), node.log()
+        np.testing.assert_allclose(
+            torques[-1].effort, inverse_dynamics(model, q, qd, qdd),
+            rtol=0, atol=1e-12)
+    finally:
+        probe.close()
+        assert node.stop() == 0

@@ -1,0 +1,141 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The ROS-free layer behind the node.
+
+Joint mapping, wrench handling, reference sampling, and the torques it
+asks the library for.
+"""
+import math
+import re
+import warnings
+
+from newton_euler_ros.core import inverse_dynamics, load_robot, mass_matrix
+from newton_euler_ros.feedforward import (APPLIED_TO_ROBOT,
+                                          FeedforwardComputer, InputRejected,
+                                          JointOrder, ReferenceTrajectory,
+                                          WrenchInput)
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope='module')
+def puma():
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return load_robot('puma560')
+
+
+def names6():
+    return [f'joint{k}' for k in range(1, 7)]
+
+
+def test_joint_order_gathers_any_order_and_ignores_extras():
+    order = JointOrder(['a', 'b', 'c'], ['c', 'a', 'b'])
+    x = order.gather(['x', 'b', 'c', 'a'], 'position', [9.0, 2.0, 3.0, 1.0])
+    assert x.tolist() == [1.0, 2.0, 3.0]
+    assert order.to_output_order(x).tolist() == [3.0, 1.0, 2.0]
+    M = np.arange(9.0).reshape(3, 3)
+    assert order.matrix_to_output_order(M)[0, 1] == M[2, 0]
+
+
+@pytest.mark.parametrize('names, values, kind, text', [
+    (['a', 'b'], [1.0, 2.0], 'missing_joints', "missing joints ['c']"),
+    (['a', 'b', 'c'], [1.0, 2.0], 'malformed', 'position has 2 entries '
+                                               'for 3 names'),
+    (['a', 'b', 'c', 'a'], [1.0] * 4, 'malformed', "'a' appears twice"),
+    (['a', 'b', 'c'], [1.0, math.nan, 2.0], 'non_finite',
+     "position of 'b' is nan"),
+])
+def test_joint_order_rejects(names, values, kind, text):
+    order = JointOrder(['a', 'b', 'c'])
+    with pytest.raises(InputRejected, match=re.escape(text)) as info:
+        order.gather(names, 'position', values)
+    assert info.value.kind == kind
+
+
+@pytest.mark.parametrize('output, text', [
+    (['a', 'b'], "missing \\['c'\\]"),
+    (['a', 'b', 'c', 'd'], "not in the robot: \\['d'\\]"),
+    (['a', 'a', 'b'], "'a' is listed twice"),
+])
+def test_joint_order_validates_output(output, text):
+    with pytest.raises(ValueError, match=text):
+        JointOrder(['a', 'b', 'c'], output)
+
+
+def test_wrench_sign_frames_and_staleness():
+    w = WrenchInput(['base_link'], ['tool0'], APPLIED_TO_ROBOT, timeout=0.5)
+    w.update('tool0', [1, 2, 3, 4, 5, 6], stamp=10.0, now=10.1)
+    wrench, frame = w.current(now=10.2)
+    assert frame == 'end_effector' and wrench.tolist() == [-1, -2, -3, -4,
+                                                           -5, -6]
+    assert w.current(now=10.6) == (None, 'end_effector')   # expired
+    assert w.expired == 1
+    with pytest.raises(InputRejected, match='is not one of') as info:
+        w.update('camera', [0] * 6, 10.0, 10.0)
+    assert info.value.kind == 'unknown_frame'
+    with pytest.raises(InputRejected) as info:
+        w.update('base_link', [0] * 6, stamp=1.0, now=10.0)
+    assert info.value.kind == 'stale'
+    with pytest.raises(InputRejected) as info:
+        w.update('base_link', [0, 0, math.inf, 0, 0, 0], 10.0, 10.0)
+    assert info.value.kind == 'non_finite'
+    w.update('base_link', [1] * 6, stamp=0.0, now=20.0)  # unstamped: now
+    assert w.current(now=20.1)[1] == 'base'
+
+
+@pytest.mark.parametrize('kwargs, text', [
+    ({'base_frames': ['x'], 'end_effector_frames': ['x']}, 'both a base'),
+    ({'base_frames': [], 'end_effector_frames': [], 'convention': 'push'},
+     'convention must be'),
+    ({'base_frames': [], 'end_effector_frames': [], 'timeout': -1.0},
+     'timeout must be >= 0'),
+])
+def test_wrench_input_validates(kwargs, text):
+    with pytest.raises(ValueError, match=text):
+        WrenchInput(**kwargs)
+
+
+def test_reference_interpolates_linearly_in_time():
+    ref = ReferenceTrajectory(JointOrder(['a', 'b']))
+    assert ref.acceleration(0.0) is None
+    ref.set(['b', 'a'], start=100.0, points=[(0.0, [0.0, 1.0]),
+                                             (2.0, [4.0, 3.0]),
+                                             (3.0, [])], now=0.0)
+    assert ref.acceleration(99.0).tolist() == [1.0, 0.0]   # before: first
+    assert ref.acceleration(101.0).tolist() == [2.0, 2.0]  # halfway
+    assert ref.acceleration(102.5).tolist() == [1.5, 2.0]  # toward zeros
+    assert ref.acceleration(200.0).tolist() == [0.0, 0.0]  # after: last
+    with pytest.raises(InputRejected, match='non-decreasing'):
+        ref.set(['a', 'b'], 0.0, [(1.0, []), (0.5, [])], now=0.0)
+
+
+def test_computer_matches_library_with_reference_and_wrench(puma):
+    order = JointOrder(puma.joint_names, list(reversed(puma.joint_names)))
+    ref = ReferenceTrajectory(order)
+    wrench = WrenchInput(['base_link'], ['tool0'], timeout=0.0)
+    ff = FeedforwardComputer(puma, order, wrench, ref)
+    rng = np.random.default_rng(3)
+    q, qd, qdd = rng.normal(size=(3, 6))
+    F = rng.normal(size=6)
+    ref.set(names6(), 0.0, [(0.0, qdd.tolist())], now=5.0)
+    wrench.update('tool0', F, 5.0, 5.0)
+    tau = ff.torques(names6(), q, qd, stamp=5.0, now=5.0)
+    expected = inverse_dynamics(puma, q, qd, qdd, F, 'end_effector')
+    assert np.abs(tau - expected[::-1]).max() < 1e-12
+    D, C, g, t = ff.terms(names6(), [], [], qdd.tolist(), now=5.0)  # latest
+    assert np.abs(D - mass_matrix(puma, q)[::-1, ::-1]).max() < 1e-12
+    assert np.abs(t - expected[::-1]).max() < 1e-12
