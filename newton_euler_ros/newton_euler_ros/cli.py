@@ -203,6 +203,37 @@ def cmd_check(args):
     return 0
 
 
+def cmd_simulate(args):
+    from .core.scene import load_scene
+    from .core.simulate import simulate
+    scene = load_scene(args.scene)
+    for message in scene.warnings:
+        print(f'warning: {message}', file=sys.stderr)
+    if args.duration is not None and not args.duration > 0.0:
+        raise CliError(f'--duration must be > 0, got {args.duration}')
+    result = simulate(scene, duration=args.duration,
+                      progress=not args.json and sys.stderr.isatty())
+    summary = result.summary
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    names = scene.model.joint_names
+    print(f'{scene.name}: {scene.model.name}, {summary["steps"]} '
+          f'{summary["integrator"]} steps of {summary["step"]} s '
+          f'({summary["duration"]:.3f} s simulated in '
+          f'{summary["wall_time_s"]:.2f} s)')
+    print(f'effects: {", ".join(summary["effects"]) or "none"}')
+    print(f'tracking error: RMS {summary["tracking_rms"]:.3e} rad, '
+          f'max {summary["tracking_max"]:.3e} rad')
+    print(f'energy drift: {summary["energy_drift_max"]:.3e} J '
+          f'({summary["energy_drift_relative"]:.1e} of the energy scale)')
+    print('final state:')
+    for j, name in enumerate(names):
+        print(f'  {name:<12} q {summary["final_q"][j]:>12.6f}   '
+              f'qd {summary["final_qd"][j]:>12.6f}')
+    return 0
+
+
 def cmd_robots(_args):
     for name in bundled_robots():
         print(name)
@@ -241,6 +272,13 @@ def build_parser():
     chk = sub.add_parser('check', help='validate a robot file')
     chk.add_argument('robot')
     chk.set_defaults(func=cmd_check)
+    sim = sub.add_parser('simulate', help='simulate a scene offline')
+    sim.add_argument('scene', help='scene YAML file or bundled scene name')
+    sim.add_argument('--duration', type=float, metavar='T',
+                     help='simulated seconds (default: the scene\'s)')
+    sim.add_argument('--json', action='store_true',
+                     help='print the summary as one JSON object')
+    sim.set_defaults(func=cmd_simulate)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
     return parser

@@ -247,3 +247,35 @@ def convert_convention(model, convention):
                          f'got {convention!r}')
     return model.replace(convention=convention, a=a, alpha=alpha, com=com,
                          inertia=inertia, base=base, tool=tool)
+
+
+def with_payload(model, mass, com, inertia):
+    """The model with a rigid payload fixed to the end effector.
+
+    The payload (``mass`` kg, centre of mass ``com`` in end-effector axes
+    and origin, ``inertia`` 3x3 about its centre of mass in end-effector
+    axes) is merged into the last link by the parallel-axis theorem, so the
+    dynamics cost nothing extra.
+    """
+    if not mass >= 0.0:
+        raise ValueError(f'payload mass must be >= 0, got {mass}')
+    R_tool = model.tool[:3, :3]
+    c_p = R_tool @ np.asarray(com, dtype=float) + model.tool[:3, 3]
+    I_p = R_tool @ np.asarray(inertia, dtype=float) @ R_tool.T
+    m_l = model.mass[-1]
+    c_l = model.com[-1]
+    m = m_l + mass
+    if m == 0.0:
+        return model
+    c = (m_l * c_l + mass * c_p) / m
+
+    def shifted(inertia_c, m_b, c_b):
+        d = c_b - c
+        return inertia_c + m_b * (d @ d * np.eye(3) - np.outer(d, d))
+
+    I_new = shifted(model.inertia[-1], m_l, c_l) + shifted(I_p, mass, c_p)
+    masses = np.array(model.mass)
+    coms = np.array(model.com)
+    inertias = np.array(model.inertia)
+    masses[-1], coms[-1], inertias[-1] = m, c, I_new
+    return model.replace(mass=masses, com=coms, inertia=inertias)
