@@ -275,7 +275,7 @@ def build_parser():
     sim = sub.add_parser('simulate', help='simulate a scene offline')
     sim.add_argument('scene', help='scene YAML file or bundled scene name')
     sim.add_argument('--duration', type=float, metavar='T',
-                     help='simulated seconds (default: the scene\'s)')
+                     help="simulated seconds (default: the scene's)")
     sim.add_argument('--json', action='store_true',
                      help='print the summary as one JSON object')
     sim.set_defaults(func=cmd_simulate)

@@ -423,7 +423,8 @@ def inverse_dynamics_batch(links, frames, Q, QD, QDD, W, gravity_on,
 
 @njit(cache=True)
 def _unit_columns(links, frames, qd, coriolis, ws, scratch, M):
-    """Columns of D (``coriolis`` False) or C(q, qd) from unit inputs.
+    """
+    Columns of D (``coriolis`` False) or C(q, qd) from unit inputs.
 
     D e_k = Y(q, 0, 0, e_k) and C e_k = Y(q, qd, e_k, 0), where Y is the
     two-stream recursion; ``joint_trig`` must have been called for q.

@@ -250,7 +250,8 @@ def convert_convention(model, convention):
 
 
 def with_payload(model, mass, com, inertia):
-    """The model with a rigid payload fixed to the end effector.
+    """
+    Return the model with a rigid payload fixed to the end effector.
 
     The payload (``mass`` kg, centre of mass ``com`` in end-effector axes
     and origin, ``inertia`` 3x3 about its centre of mass in end-effector

@@ -51,7 +51,7 @@ class Effects:
     armature: bool = False
 
     def names(self):
-        """The enabled effects, in a fixed order."""
+        """Return the enabled effects, in a fixed order."""
         return [k for k in ('gravity', 'velocity_products', 'payload',
                             'wrench', 'friction', 'armature')
                 if getattr(self, k)]
@@ -59,7 +59,8 @@ class Effects:
 
 @dataclass(frozen=True)
 class WrenchSchedule:
-    """An end-effector wrench over time (exerted by the robot).
+    """
+    An end-effector wrench over time (exerted by the robot).
 
     ``kind`` is ``constant``, ``schedule`` (piecewise-linear in time) or
     ``topic`` (live from the ROS ``wrench`` topic; offline it is zero).
@@ -71,7 +72,7 @@ class WrenchSchedule:
     values: np.ndarray
 
     def at(self, t):
-        """The wrench at time ``t`` (s), a (6,) array."""
+        """Return the wrench at time ``t`` (s), a (6,) array."""
         if self.kind == 'topic':
             return np.zeros(6)
         if len(self.times) == 1:
@@ -139,7 +140,7 @@ class Scene:
 
 
 def _flag_or_block(value, where):
-    """(enabled, block): true/false, null (off) or a mapping (on)."""
+    """Return (enabled, block): true/false, null (off) or a mapping (on)."""
     if value is None or value is False:
         return False, None
     if value is True:
@@ -329,8 +330,7 @@ def scene_from_dict(data, origin, base_dir='.'):
     step = to_number(integ.get('step'), f'{origin}: integrator.step')
     duration = to_number(integ.get('duration'),
                          f'{origin}: integrator.duration')
-    rate = to_number(integ.get('rate', 1.0 / step),
-                     f'{origin}: integrator.rate')
+    rate = to_number(integ.get('rate', 250.0), f'{origin}: integrator.rate')
     for key, value in (('step', step), ('duration', duration),
                        ('rate', rate)):
         if value <= 0.0:

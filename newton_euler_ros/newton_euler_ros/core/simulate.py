@@ -32,8 +32,8 @@ import time
 import numpy as np
 
 from . import _kernels as K
-from .dynamics import (Workspace, inverse_dynamics, jacobian, link_poses,
-                       mass_matrix)
+from .dynamics import (inverse_dynamics, jacobian, link_poses, mass_matrix,
+                       Workspace)
 from .errors import NotPositiveDefiniteError
 
 
@@ -116,7 +116,8 @@ class SceneDynamics:
 
 
 def tracking_controller(dyn, feedforward=None):
-    """PD on the scene's reference, plus feedforward torques.
+    """
+    PD on the scene's reference, plus feedforward torques.
 
     ``feedforward`` defaults to the scene's setting.  The feedforward is
     the scene's inverse dynamics at the desired state.
@@ -159,7 +160,8 @@ class SimulationResult:
 
 def simulate(scene, duration=None, controller=None, feedforward=None,
              integrator=None, step=None, progress=False):
-    """Simulate a scene deterministically; return a SimulationResult.
+    """
+    Simulate a scene deterministically; return a SimulationResult.
 
     ``controller(t, q, qd) -> (tau, tau_ff)`` defaults to
     :func:`tracking_controller`; torques are held constant over each step
