@@ -35,6 +35,7 @@ import numpy as np
 
 from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
                    mass_matrix, Workspace)
+from .core.simulate import SceneDynamics
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
@@ -260,15 +261,25 @@ class FeedforwardComputer:
     reference, so that a node only converts messages.
     """
 
-    def __init__(self, model, order, wrench_input, reference=None):
-        self.model = model
+    def __init__(self, model, order, wrench_input, reference=None,
+                 scene=None):
+        self.scene = scene
+        self.dyn = SceneDynamics(scene) if scene is not None else None
+        self.model = scene.model if scene is not None else model
         self.order = order
         self.wrench = wrench_input
         self.reference = reference
-        self.ws = Workspace(model)
-        self.tau = np.empty(model.n)
+        self.ws = self.dyn.ws if self.dyn is not None else Workspace(model)
+        self.tau = np.empty(self.model.n)
         self.last_q = None
         self.last_qd = None
+
+    def _torques(self, q, qd, qdd, w, frame, out=None):
+        """Inverse dynamics with the scene's effects, or all of them."""
+        if self.dyn is not None:
+            return self.dyn.torques_for_wrench(q, qd, qdd, w, frame, out=out)
+        return inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws,
+                                out=out)
 
     def warm_up(self):
         """
@@ -284,6 +295,7 @@ class FeedforwardComputer:
         mass_matrix(self.model, z, ws=self.ws)
         coriolis_matrix(self.model, z, z, ws=self.ws)
         gravity_torques(self.model, z, ws=self.ws)
+        self._torques(z, z, z, None, 'base')
 
     def torques(self, names, position, velocity, stamp, now):
         """Output-ordered torques for one joint state, or InputRejected."""
@@ -295,8 +307,7 @@ class FeedforwardComputer:
                if self.reference is not None else None)
         self.last_q, self.last_qd = q, qd
         w, frame = self.wrench.current(now)
-        tau = inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws,
-                               out=self.tau)
+        tau = self._torques(q, qd, qdd, w, frame, out=self.tau)
         if not np.isfinite(tau).all():   # finite input; guard the output
             raise InputRejected('non_finite', 'dynamics produced a '
                                 'non-finite torque')
@@ -328,7 +339,15 @@ class FeedforwardComputer:
         D = mass_matrix(self.model, q, ws=self.ws)
         C = coriolis_matrix(self.model, q, qd, ws=self.ws)
         g = gravity_torques(self.model, q, ws=self.ws)
-        tau = inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws)
+        if self.scene is not None:      # the terms the scene has
+            eff = self.scene.effects
+            if eff.armature:
+                D[np.diag_indices_from(D)] += self.scene.armature
+            if not eff.velocity_products:
+                C[:] = 0.0
+            if not eff.gravity:
+                g[:] = 0.0
+        tau = self._torques(q, qd, qdd, w, frame)
         o = self.order
         out = (o.matrix_to_output_order(D), o.matrix_to_output_order(C),
                o.to_output_order(g), o.to_output_order(tau))

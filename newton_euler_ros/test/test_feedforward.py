@@ -139,3 +139,30 @@ def test_computer_matches_library_with_reference_and_wrench(puma):
     D, C, g, t = ff.terms(names6(), [], [], qdd.tolist(), now=5.0)  # latest
     assert np.abs(D - mass_matrix(puma, q)[::-1, ::-1]).max() < 1e-12
     assert np.abs(t - expected[::-1]).max() < 1e-12
+
+
+def test_scene_selects_the_nodes_effects():
+    from newton_euler_ros.core.scene import load_scene
+    from newton_euler_ros.core.simulate import SceneDynamics
+    orbit = load_scene('panda_orbit_slow')       # no gravity, no qd terms
+    order = JointOrder(orbit.model.joint_names)
+    ff = FeedforwardComputer(None, order, WrenchInput([], []), None, orbit)
+    names = list(orbit.model.joint_names)
+    q = orbit.q0
+    tau = ff.torques(names, q, np.full(7, 0.5), stamp=0.0, now=0.0)
+    assert np.all(tau == 0.0)                    # at rest in orbit: nothing
+    D, C, g, t = ff.terms(names, q, np.full(7, 0.5), np.ones(7), now=0.0)
+    assert np.all(C == 0.0) and np.all(g == 0.0)
+    np.testing.assert_allclose(t, D @ np.ones(7), rtol=0, atol=1e-12)
+    press = load_scene('puma_payload_press')     # every effect
+    order = JointOrder(press.model.joint_names)
+    ff = FeedforwardComputer(None, order, WrenchInput([], []), None, press)
+    rng = np.random.default_rng(5)
+    q, qd = rng.normal(size=(2, 6))
+    expected = SceneDynamics(press).torques_for_wrench(q, qd, None, None)
+    got = ff.torques(names6(), q, qd, stamp=0.0, now=0.0)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        bare = inverse_dynamics(load_robot('puma560'), q, qd)
+    assert np.abs(got - bare).max() > 0.1        # payload + friction count

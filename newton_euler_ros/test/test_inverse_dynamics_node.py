@@ -306,6 +306,10 @@ def test_stops_cleanly(graph):
     (['-p', 'wrench.convention:=pushing'], 'wrench.convention: must be one '
                                            'of'),
     (['-p', 'qos.depth:=0'], 'qos.depth: must be > 0'),
+    (['-p', 'scene:=no_such_scene'], 'scene: no_such_scene: no such file'),
+    (['-p', "robot_file:=''"],
+     'robot_file: must not be empty (or set scene)'),
+    (['-p', 'robot_file:='], 'cannot start'),
 ])
 def test_bad_parameters_refuse_to_start(tmp_path, args, message):
     proc = subprocess.run(node_cmd(*args), env=ros_env(domain_id(29)),
@@ -349,6 +353,31 @@ def test_reference_accelerations_enter_the_torques(tmp_path, model):
         np.testing.assert_allclose(
             torques[-1].effort, inverse_dynamics(model, q, qd, qdd),
             rtol=0, atol=1e-12)
+    finally:
+        probe.close()
+        assert node.stop() == 0
+
+
+def test_scene_parameter_selects_effects(tmp_path):
+    from newton_euler_ros.core.scene import load_scene
+    from newton_euler_ros.core.simulate import SceneDynamics
+    scene = load_scene('puma_payload_press')
+    domain = domain_id(43)
+    node = NodeProcess(node_cmd('-p', 'scene:=puma_payload_press'), domain,
+                       str(tmp_path / 'node.log'))
+    probe = Probe(domain)
+    try:
+        q, qd = STATES[1]
+        req = ComputeDynamics.Request(name=list(scene.model.joint_names),
+                                      position=q.tolist(),
+                                      velocity=qd.tolist())
+        res = probe.call(ComputeDynamics, f'{NODE}/compute_dynamics', req,
+                         timeout=90.0)
+        assert res.success, res.message
+        expected = SceneDynamics(scene).torques_for_wrench(q, qd, None, None)
+        np.testing.assert_allclose(res.torque, expected, rtol=0, atol=1e-12)
+        assert "effects ['gravity', 'velocity_products', 'payload'" \
+            in node.log()
     finally:
         probe.close()
         assert node.stop() == 0

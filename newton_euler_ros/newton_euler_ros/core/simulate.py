@@ -61,14 +61,26 @@ class SceneDynamics:
         return self.scene.viscous * qd + self.scene.coulomb * np.sign(qd)
 
     def torques(self, q, qd, qdd, t):
-        """Inverse dynamics with exactly the scene's effects."""
+        """Inverse dynamics with exactly the scene's effects at time t."""
         w, frame = self.wrench(t)
+        return self.torques_for_wrench(q, qd, qdd, w, frame)
+
+    def torques_for_wrench(self, q, qd, qdd, wrench, frame='base',
+                           out=None):
+        """
+        Inverse dynamics with the scene's effects and a given wrench.
+
+        ``wrench`` is ignored (no Jacobian is formed) unless the scene has
+        the wrench effect; ``qdd`` may be None (zeros).
+        """
         eff = self.effects
-        tau = inverse_dynamics(self.model, q, qd, qdd, w, frame,
+        if not eff.wrench:
+            wrench = None
+        tau = inverse_dynamics(self.model, q, qd, qdd, wrench, frame,
                                gravity=eff.gravity,
                                velocity_products=eff.velocity_products,
-                               ws=self.ws)
-        if eff.armature:
+                               ws=self.ws, out=out)
+        if eff.armature and qdd is not None:
             tau += self.scene.armature * qdd
         if eff.friction:
             tau += self.friction(qd)

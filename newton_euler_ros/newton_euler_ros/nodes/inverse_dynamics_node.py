@@ -45,6 +45,7 @@ from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
 from ..core import inspect_robot, NewtonEulerError
+from ..core.scene import load_scene
 from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
                            ReferenceTrajectory, WrenchInput)
 from ..parameters import load_specs, validate
@@ -75,10 +76,20 @@ class InverseDynamicsNode(Node):
         super().__init__('inverse_dynamics_node', **kwargs)
         self.specs = load_specs()
         p = self._declare_parameters()
+        scene = None
         try:
-            model, found, path = inspect_robot(p['robot_file'])
+            if p['scene']:
+                scene = load_scene(p['scene'])
+                model, found, path = (scene.model, scene.warnings,
+                                      scene.robot_path)
+            elif p['robot_file']:
+                model, found, path = inspect_robot(p['robot_file'])
+            else:
+                raise ConfigurationError(
+                    'robot_file: must not be empty (or set scene)')
         except NewtonEulerError as exc:
-            raise ConfigurationError(f'robot_file: {exc}') from None
+            key = 'scene' if p['scene'] else 'robot_file'
+            raise ConfigurationError(f'{key}: {exc}') from None
         for message in found:
             self.get_logger().warning(f'robot file: {message}')
         try:
@@ -88,7 +99,8 @@ class InverseDynamicsNode(Node):
             raise ConfigurationError(str(exc)) from None
         reference = (ReferenceTrajectory(order)
                      if p['acceleration_source'] == 'reference' else None)
-        self.ff = FeedforwardComputer(model, order, wrench, reference)
+        self.ff = FeedforwardComputer(model, order, wrench, reference,
+                                      scene)
         self.ff.warm_up()   # compile or load the kernels before any message
         self.counts = dict.fromkeys(COUNTERS, 0)
         self.log_throttle = p['log_throttle']
@@ -121,7 +133,9 @@ class InverseDynamicsNode(Node):
         self.get_logger().info(
             f'{model.name} ({path}): {model.n} joints '
             f'[{", ".join(order.output_joints)}], qdd from '
-            f'{p["acceleration_source"]}, wrench frames '
+            f'{p["acceleration_source"]}, effects '
+            f'{scene.effects.names() if scene else "all rigid-body"}, '
+            f'wrench frames '
             f'{sorted(wrench.frames)}')
 
     # ---- parameters ----
@@ -280,7 +294,12 @@ class InverseDynamicsNode(Node):
 
 def main(args=None):
     """Entry point of the ``inverse_dynamics_node`` console script."""
-    rclpy.init(args=args)
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # e.g. malformed --ros-args: say so, briefly
+        print(f'inverse_dynamics_node: cannot start: {exc}'.splitlines()[0],
+              file=sys.stderr)
+        return 2
     node = None
     code = 0
     try:
