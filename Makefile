@@ -2,7 +2,7 @@
 #   make setup   create/refresh .venv (idempotent; < 2 s when up to date)
 #   make test    set up if needed, then run pytest over newton_euler_ros/test
 #   make demo    run the CLI on the PUMA 560
-#   make bench   run the benchmark
+#   make bench   run the benchmarks (peers side by side; cost per effect)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
 #   make colcon-check  build both packages as a ROS 2 workspace with colcon
 #   make clean   remove build/, .venv and the stamps in it
@@ -23,7 +23,7 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
 
-.PHONY: setup test demo bench peers colcon-check clean
+.PHONY: setup test demo bench latency peers colcon-check clean
 
 setup:
 	@bash scripts/setup_env.sh
@@ -36,6 +36,10 @@ demo: setup
 
 bench: setup
 	$(PY) -m newton_euler_ros.bench
+	$(PY) -m newton_euler_ros.bench_effects
+
+latency: setup
+	$(PY) -m newton_euler_ros.latency_bench
 
 # Constrained by the main lock so the peers cannot move numpy & co.
 peers: setup

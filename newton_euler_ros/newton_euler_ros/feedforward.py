@@ -342,7 +342,7 @@ class FeedforwardComputer:
         if self.scene is not None:      # the terms the scene has
             eff = self.scene.effects
             if eff.armature:
-                D[np.diag_indices_from(D)] += self.scene.armature
+                D.flat[::D.shape[0] + 1] += self.scene.armature
             if not eff.velocity_products:
                 C[:] = 0.0
             if not eff.gravity:

@@ -228,3 +228,11 @@ def test_numbers_as_strings_are_coerced():
     data = copy.deepcopy(data)
     data['integrator']['step'] = '1e-3'     # how PyYAML reads 1e-3
     assert scene_from_dict(data, 's.yaml', folder).step == 1e-3
+
+
+def test_effect_benchmark_runs(capsys):
+    """Smoke test: the effect benchmark runs (its figures are not judged)."""
+    from newton_euler_ros import bench_effects
+    assert bench_effects.main(['puma_payload_press', '--quick']) == 0
+    out = capsys.readouterr().out
+    assert 'without friction' in out and 'none (D qdd only)' in out

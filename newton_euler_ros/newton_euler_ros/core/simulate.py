@@ -91,7 +91,7 @@ class SceneDynamics:
         bias = self.torques(q, qd, np.zeros_like(q), t)
         D = mass_matrix(self.model, q, ws=self.ws, out=self._D)
         if self.effects.armature:
-            D[np.diag_indices_from(D)] += self.scene.armature
+            D.flat[::D.shape[0] + 1] += self.scene.armature
         qdd = np.empty_like(q)
         bad = K.cholesky_solve(D, tau - bias, self._L, qdd)
         if bad >= 0:

@@ -35,15 +35,13 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
-import rclpy
-from rclpy.executors import ExternalShutdownException
 from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
 from trajectory_msgs.msg import JointTrajectory
 
+from .common import ConfigurationError, qos_profile, run_node
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
 from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
@@ -59,10 +57,6 @@ _PARAM_TYPES = {
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
             'service_calls', 'service_failures', 'internal_error')
-
-
-class ConfigurationError(Exception):
-    """The node's parameters are invalid; it refuses to start."""
 
 
 def _seconds(stamp):
@@ -106,9 +100,7 @@ class InverseDynamicsNode(Node):
         self.log_throttle = p['log_throttle']
         self._last_log = {}
 
-        qos = QoSProfile(depth=p['qos.depth'], reliability=(
-            ReliabilityPolicy.RELIABLE if p['qos.reliability'] == 'reliable'
-            else ReliabilityPolicy.BEST_EFFORT))
+        qos = qos_profile(p['qos.depth'], p['qos.reliability'])
         self.cmd_pub = self.create_publisher(Float64MultiArray,
                                              '~/torque_command', qos)
         self.torque_pub = self.create_publisher(JointState, '~/torques', qos)
@@ -294,29 +286,7 @@ class InverseDynamicsNode(Node):
 
 def main(args=None):
     """Entry point of the ``inverse_dynamics_node`` console script."""
-    try:
-        rclpy.init(args=args)
-    except Exception as exc:  # e.g. malformed --ros-args: say so, briefly
-        print(f'inverse_dynamics_node: cannot start: {exc}'.splitlines()[0],
-              file=sys.stderr)
-        return 2
-    node = None
-    code = 0
-    try:
-        node = InverseDynamicsNode()
-        rclpy.spin(node)
-    except ConfigurationError as exc:
-        # refuse to start, with the reason on one line
-        print(f'inverse_dynamics_node: invalid parameters: {exc}',
-              file=sys.stderr)
-        code = 2
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
-    finally:
-        if node is not None:
-            node.destroy_node()
-        rclpy.try_shutdown()
-    return code
+    return run_node(InverseDynamicsNode, 'inverse_dynamics_node', args)
 
 
 if __name__ == '__main__':

@@ -1,0 +1,84 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+What every node of the package shares: QoS from parameters, and main().
+
+``run_node`` is the Jazzy-style main: init, build the node (a
+configuration error refuses to start with a one-line reason and exit
+status 2), spin until SIGINT/SIGTERM or shutdown, destroy, shut down.
+
+Spinning uses rclpy's EventsExecutor through ``spin_once`` when it is
+available: measured with ``make latency``, it halves the node's CPU use
+and lowers the p99 input-to-torque latency.  Its ``spin()`` is avoided
+(in this rclpy build it busy-waits and ignores shutdown).  Set
+``NEWTON_EULER_EXECUTOR=single_threaded`` to use the classic executor.
+"""
+import os
+import sys
+
+import rclpy
+from rclpy.executors import ExternalShutdownException, \
+    SingleThreadedExecutor
+from rclpy.qos import QoSProfile, ReliabilityPolicy
+
+
+class ConfigurationError(Exception):
+    """A node's parameters are invalid; it refuses to start."""
+
+
+def qos_profile(depth, reliability):
+    """Return a QoS profile for a history depth and 'reliable'/'best_effort'."""
+    return QoSProfile(depth=depth, reliability=(
+        ReliabilityPolicy.RELIABLE if reliability == 'reliable'
+        else ReliabilityPolicy.BEST_EFFORT))
+
+
+def make_executor():
+    """Return the executor to spin with (EventsExecutor when available)."""
+    if os.environ.get('NEWTON_EULER_EXECUTOR') != 'single_threaded':
+        try:
+            from rclpy.experimental import EventsExecutor
+            return EventsExecutor()
+        except ImportError:
+            pass
+    return SingleThreadedExecutor()
+
+
+def run_node(make_node, name, args=None):
+    """Run a node until shutdown; return the process exit status."""
+    try:
+        rclpy.init(args=args)
+    except Exception as exc:  # e.g. malformed --ros-args: say so, briefly
+        print(f'{name}: cannot start: {exc}'.splitlines()[0],
+              file=sys.stderr)
+        return 2
+    node = None
+    code = 0
+    try:
+        node = make_node()
+        executor = make_executor()
+        executor.add_node(node)
+        while rclpy.ok():
+            executor.spin_once(timeout_sec=0.1)
+    except ConfigurationError as exc:
+        print(f'{name}: invalid parameters: {exc}', file=sys.stderr)
+        code = 2
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return code
