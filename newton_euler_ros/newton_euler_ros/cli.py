@@ -212,6 +212,7 @@ def cmd_simulate(args):
     if args.duration is not None and not args.duration > 0.0:
         raise CliError(f'--duration must be > 0, got {args.duration}')
     result = simulate(scene, duration=args.duration,
+                      feedforward=False if args.no_feedforward else None,
                       progress=not args.json and sys.stderr.isatty())
     summary = result.summary
     if args.json:
@@ -223,7 +224,9 @@ def cmd_simulate(args):
           f'({summary["duration"]:.3f} s simulated in '
           f'{summary["wall_time_s"]:.2f} s)')
     print(f'effects: {", ".join(summary["effects"]) or "none"}')
-    print(f'tracking error: RMS {summary["tracking_rms"]:.3e} rad, '
+    ff = 'PD alone' if args.no_feedforward else (
+        'PD + feedforward' if scene.feedforward else 'PD alone')
+    print(f'tracking error ({ff}): RMS {summary["tracking_rms"]:.3e} rad, '
           f'max {summary["tracking_max"]:.3e} rad')
     print(f'energy drift: {summary["energy_drift_max"]:.3e} J '
           f'({summary["energy_drift_relative"]:.1e} of the energy scale)')
@@ -278,6 +281,9 @@ def build_parser():
                      help="simulated seconds (default: the scene's)")
     sim.add_argument('--json', action='store_true',
                      help='print the summary as one JSON object')
+    sim.add_argument('--no-feedforward', action='store_true',
+                     help='PD alone, without the inverse-dynamics '
+                          'feedforward (for comparison)')
     sim.set_defaults(func=cmd_simulate)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
