@@ -94,7 +94,8 @@ H_IFACE="$(printf '%s %s' "$H_VENV" "$(hash_inputs "$IFACE_SRC")" | sha256sum | 
 H_PKG="$(printf '%s %s' "$H_VENV" "$(hash_inputs \
   "$PKG_SRC/setup.py" "$PKG_SRC/setup.cfg" "$PKG_SRC/package.xml" \
   "$PKG_SRC/resource" "$PKG_SRC/config" "$PKG_SRC/launch" \
-  "$PKG_SRC/newton_euler_ros/__init__.py")" | sha256sum | cut -d' ' -f1)"
+  "$PKG_SRC/newton_euler_ros/__init__.py" \
+  "$ROOT/scripts/setup_env.sh")" | sha256sum | cut -d' ' -f1)"
 
 if [[ "${SETUP_FORCE:-0}" != 1 && -x "$VENV/bin/python" ]] \
    && stamp_ok venv "$H_VENV" && stamp_ok interfaces "$H_IFACE" \
@@ -254,8 +255,13 @@ if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok package "$H_PKG"; then
   # scripts to .venv/bin (setup.cfg's [develop]/[install] script dirs are
   # for colcon and are not used here).  --no-build-isolation: build with
   # the pinned setuptools/wheel already in the venv, no extra download.
+  # editable_mode=compat: a plain path entry (.pth) instead of an import
+  # hook, so that from the repository root the regular package wins over
+  # the namespace package Python would otherwise make of the
+  # newton_euler_ros/ folder in the current directory.
   pip_filtered "$VENV/bin/python" -m pip install --progress-bar off -q \
     --no-deps --no-build-isolation --use-pep517 -e "$PKG_SRC" \
+    --config-settings editable_mode=compat \
     || die "pip install -e newton_euler_ros failed"
   # Editable wheels leave setup.py's data_files out.  Install them as colcon
   # would (share/newton_euler_ros/..., ament index marker), taking the list

@@ -135,3 +135,15 @@ def test_bad_states_file(tmp_path):
     code, _, err = run('dynamics', 'planar_2r', '--states', str(path))
     assert code != 0
     assert 'state 0: q: must be a list of 2 numbers' in err
+
+
+def test_package_imports_from_the_repository_root():
+    """The newton_euler_ros/ folder must not shadow the installed package."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__))))
+    proc = subprocess.run(
+        [sys.executable, '-c', 'import newton_euler_ros as p; '
+                               'print(p.__file__, p.__version__)'],
+        capture_output=True, text=True, timeout=60, cwd=root)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip().endswith('__init__.py 0.1.0'), proc.stdout
