@@ -1,0 +1,156 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The same Newton-Euler recursion in high precision (mpmath), as a reference.
+
+The source of ``_kernels`` is executed a second time with ``njit``
+replaced by the identity and ``math`` by mpmath, over numpy object arrays
+of ``mpf`` numbers: one implementation of the recursion, evaluated at 50
+significant digits (by default) from the exact float64 inputs.  The DH
+angles' cosines and sines, the base rotation applied to gravity, and all
+arithmetic are done at that precision; the model's float64 numbers (and
+the float64 base/tool matrices) are taken as exact.
+
+Slow (milliseconds per call): for measuring the error of the float64 and
+float32 paths, never for control.
+"""
+import os
+import types
+
+import mpmath
+import numpy as np
+
+from . import _kernels as K
+
+_SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
+                       '_kernels.py')
+
+
+class _MpMath:
+    """The few ``math`` functions the kernels call, in mpmath."""
+
+    cos = staticmethod(mpmath.cos)
+    sin = staticmethod(mpmath.sin)
+    sqrt = staticmethod(mpmath.sqrt)
+
+    @staticmethod
+    def isfinite(x):
+        """Return True for a finite number."""
+        return bool(mpmath.isfinite(x))
+
+
+def _load_kernels():
+    module = types.ModuleType('newton_euler_ros.core._kernels_mp')
+    module.__dict__['__njit_override__'] = lambda f=None, **kw: (
+        f if f is not None else (lambda g: g))
+    with open(_SOURCE, encoding='utf-8') as fh:
+        code = compile(fh.read(), _SOURCE, 'exec')
+    exec(code, module.__dict__)  # noqa: S102 - our own source file
+    module.__dict__['math'] = _MpMath
+    return module
+
+
+_MP = _load_kernels()
+
+
+def _mp_array(x):
+    flat = [mpmath.mpf(float(v)) for v in np.ravel(x)]
+    return np.array(flat, dtype=object).reshape(np.shape(x))
+
+
+class HighPrecisionModel:
+    """A model's kernel arrays converted to mpmath at ``dps`` digits."""
+
+    def __init__(self, model, dps=50):
+        self.model = model
+        self.dps = dps
+        with mpmath.workdps(dps):
+            links = _mp_array(model.links_array)
+            for j in range(model.n):
+                alpha = mpmath.mpf(float(model.alpha[j]))
+                links[j, K.L_CA] = mpmath.cos(alpha)
+                links[j, K.L_SA] = mpmath.sin(alpha)
+            frames = _mp_array(model.frames_array)
+            R = _mp_array(model.base[:3, :3])
+            g = _mp_array(model.gravity)
+            for i in range(3):
+                frames[K.F_GRAV, i] = sum(R[k, i] * g[k] for k in range(3))
+        self.links = links
+        self.frames = frames
+
+    def _vec(self, x, size):
+        if x is None:
+            return _mp_array(np.zeros(size))
+        return _mp_array(np.asarray(x, dtype=np.float64))
+
+    def inverse_dynamics(self, q, qd=None, qdd=None, wrench=None,
+                         wrench_frame='base', gravity=True,
+                         velocity_products=True):
+        """Return tau as an object array of mpf (see the float64 API)."""
+        n = self.model.n
+        mode = K.WRENCH_NONE if wrench is None else (
+            K.WRENCH_BASE if wrench_frame == 'base' else K.WRENCH_EE)
+        with mpmath.workdps(self.dps):
+            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            tau = np.empty(n, dtype=object)
+            qv = self._vec(q, n)
+            qdv = self._vec(qd, n)
+            _MP.joint_trig(self.links, qv, ws)
+            _MP.recursion(self.links, self.frames, qdv, qdv,
+                          self._vec(qdd, n), self._vec(wrench, 6), gravity,
+                          velocity_products, mode, ws, tau)
+        return tau
+
+    def mass_matrix(self, q):
+        """Return D(q) as an (n, n) object array of mpf."""
+        n = self.model.n
+        with mpmath.workdps(self.dps):
+            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            scratch = np.empty((3, n), dtype=object)
+            D = np.empty((n, n), dtype=object)
+            qv = self._vec(q, n)
+            _MP.joint_trig(self.links, qv, ws)
+            zero = mpmath.mpf(0)
+            for i in range(3):
+                for k in range(n):
+                    scratch[i, k] = zero
+            _MP._unit_columns(self.links, self.frames, qv, False, ws,
+                              scratch, D)
+        return D
+
+    def coriolis_matrix(self, q, qd):
+        """Return the Christoffel C(q, qd) as an object array of mpf."""
+        n = self.model.n
+        with mpmath.workdps(self.dps):
+            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            scratch = np.empty((3, n), dtype=object)
+            C = np.empty((n, n), dtype=object)
+            _MP.joint_trig(self.links, self._vec(q, n), ws)
+            zero = mpmath.mpf(0)
+            for i in range(3):
+                for k in range(n):
+                    scratch[i, k] = zero
+            _MP._unit_columns(self.links, self.frames, self._vec(qd, n),
+                              True, ws, scratch, C)
+        return C
+
+
+def relative_error(approx, exact):
+    """Return max |approx - exact| / max(max |exact|, tiny), as a float."""
+    exact = np.asarray(exact, dtype=object)
+    diff = max(abs(mpmath.mpf(float(a)) - e)
+               for a, e in zip(np.ravel(approx), np.ravel(exact)))
+    scale = max(abs(e) for e in np.ravel(exact))
+    return float(diff / max(scale, mpmath.mpf('1e-300')))
