@@ -93,3 +93,14 @@ def test_docstring_examples_run():
     for module in (dynamics, robot_file):
         result = doctest.testmod(module)
         assert result.failed == 0
+
+
+def test_condition_number_of_d(arm):
+    """Check cond(D) against the 2x2 eigenvalues in closed form."""
+    from newton_euler_ros.core import mass_matrix_condition
+    q = [0.3, 1.1]
+    D = mass_matrix(arm, q)
+    a, b, c = D[0, 0], D[0, 1], D[1, 1]
+    root = math.sqrt(((a - c) / 2) ** 2 + b * b)
+    expected = ((a + c) / 2 + root) / ((a + c) / 2 - root)
+    assert mass_matrix_condition(arm, q) == pytest.approx(expected, rel=1e-12)

@@ -21,8 +21,8 @@ of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``.
 from .dynamics import (coriolis_matrix, end_effector_pose, forward_dynamics,
                        gravity_torques, inverse_dynamics,
                        inverse_dynamics_batch, jacobian, link_poses,
-                       mass_matrix, velocity_products, Workspace,
-                       wrench_torques)
+                       mass_matrix, mass_matrix_condition,
+                       velocity_products, Workspace, wrench_torques)
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
 from .model import make_model, pose_matrix, RobotModel, rpy_matrix
@@ -35,6 +35,7 @@ __all__ = [
     'bundled_robots', 'coriolis_matrix', 'end_effector_pose',
     'forward_dynamics', 'gravity_torques', 'inspect_robot',
     'inverse_dynamics', 'inverse_dynamics_batch', 'jacobian', 'link_poses',
-    'load_robot', 'make_model', 'mass_matrix', 'pose_matrix',
+    'load_robot', 'make_model', 'mass_matrix', 'mass_matrix_condition',
+    'pose_matrix',
     'robot_from_dict', 'rpy_matrix', 'velocity_products', 'wrench_torques',
 ]

@@ -248,6 +248,18 @@ def mass_matrix(model, q, *, ws=None, out=None):
     return D
 
 
+def mass_matrix_condition(model, q, *, ws=None):
+    """
+    Return the 2-norm condition number of D(q), lambda_max / lambda_min.
+
+    It bounds how much a relative error in the torques can grow in the
+    accelerations of :func:`forward_dynamics`; ``inf`` when D is singular.
+    Cost: D plus a symmetric eigenvalue solve, O(n^3).
+    """
+    eig = np.linalg.eigvalsh(mass_matrix(model, q, ws=ws))
+    return float(eig[-1] / eig[0]) if eig[0] > 0.0 else float('inf')
+
+
 def coriolis_matrix(model, q, qd, *, ws=None, out=None):
     """
     Coriolis/centrifugal matrix C(q, qd) built from Christoffel symbols.
