@@ -1,7 +1,7 @@
 # newton_euler_ros: one-command set-up, tests, demo and benchmark.
 #   make setup   create/refresh .venv (idempotent; < 2 s when up to date)
 #   make test    set up if needed, then run pytest over newton_euler_ros/test
-#   make demo    run the CLI on the PUMA 560
+#   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
 #   make colcon-check  build both packages as a ROS 2 workspace with colcon
@@ -32,7 +32,7 @@ test: setup
 	$(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
 
 demo: setup
-	$(VENV)/bin/newton-euler dynamics puma560 --q 0 0.5 -0.3 0.1 0.2 0.3 --qd 0.1 0.2 0.3 0.4 0.5 0.6
+	$(PY) -m newton_euler_ros.demo
 
 bench: setup
 	$(PY) -m newton_euler_ros.bench

@@ -72,6 +72,9 @@ setup(
             'newton-euler = newton_euler_ros.cli:main',
             'inverse_dynamics_node = '
             'newton_euler_ros.nodes.inverse_dynamics_node:main',
+            'robot_sim_node = newton_euler_ros.nodes.robot_sim_node:main',
+            'tracking_controller_node = '
+            'newton_euler_ros.nodes.tracking_controller_node:main',
         ],
     },
 )

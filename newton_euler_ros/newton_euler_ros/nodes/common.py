@@ -26,6 +26,7 @@ and lowers the p99 input-to-torque latency.  Its ``spin()`` is avoided
 ``NEWTON_EULER_EXECUTOR=single_threaded`` to use the classic executor.
 """
 import os
+import signal
 import sys
 
 import rclpy
@@ -58,6 +59,13 @@ def make_executor():
 
 def run_node(make_node, name, args=None):
     """Run a node until shutdown; return the process exit status."""
+    # rclpy's SIGINT handler shuts the context down and then chains to the
+    # previous handler; Python's default one would raise KeyboardInterrupt
+    # wherever the main thread is, which inside an executor callback
+    # surfaces as a RuntimeError and exit status 1.  A no-op handler leaves
+    # the clean stop to rclpy (installed before init, so rclpy chains to
+    # it).
+    signal.signal(signal.SIGINT, lambda signum, frame: None)
     try:
         rclpy.init(args=args)
     except Exception as exc:  # e.g. malformed --ros-args: say so, briefly

@@ -1,0 +1,497 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Closed-loop demo: simulator, inverse dynamics and a tracking controller.
+
+    python -m newton_euler_ros.demo [--scene NAME] [--duration T]
+                                    [--out DIR] [--quick]
+
+Runs the scene twice, each time as three ROS processes in a domain of
+its own (discovery on localhost): robot_sim_node, inverse_dynamics_node
+(desired accelerations from the controller's reference) and
+tracking_controller_node, once with the feedforward and once with PD
+alone.  A probe in this process records joint states and commands.  The
+children are stopped with SIGINT and must exit 0.  Then plots (joint
+tracking, torques split by term, tracking error) and ``summary.md`` are
+written to DIR (default out/demo).
+"""
+import argparse
+import contextlib
+import io
+import os
+import signal
+import subprocess
+import sys
+import time
+import warnings
+
+import numpy as np
+
+SCENE = 'puma_payload_press'
+QUICK_DURATION = 1.0
+SIM = '/robot_sim_node'
+ID = '/inverse_dynamics_node'
+STARTUP_TIMEOUT = 120.0     # first run may compile the numba kernels
+
+
+class DemoError(Exception):
+    """The demo could not run to completion."""
+
+
+def child_env(domain):
+    """Return this environment plus a domain id and localhost discovery."""
+    env = dict(os.environ)      # LD_LIBRARY_PATH inherited, never replaced
+    env['ROS_DOMAIN_ID'] = str(domain)
+    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    env['PYTHONUNBUFFERED'] = '1'
+    return env
+
+
+def base_domain():
+    """Return the first domain id to use (from ROS_DOMAIN_ID, else pid)."""
+    value = os.environ.get('ROS_DOMAIN_ID', '')
+    if value.isdigit():
+        return int(value)
+    return 1 + os.getpid() % 100
+
+
+class Child:
+    """A node process with its output in a log file."""
+
+    def __init__(self, label, module, ros_args, domain, log_dir):
+        self.label = label
+        self.log_path = os.path.join(log_dir, f'{label}.log')
+        self._log = open(self.log_path, 'w')
+        cmd = [sys.executable, '-m', module, '--ros-args', *ros_args]
+        self.proc = subprocess.Popen(cmd, env=child_env(domain),
+                                     stdout=self._log,
+                                     stderr=subprocess.STDOUT)
+
+    def check_alive(self):
+        if self.proc.poll() is not None:
+            raise DemoError(f'{self.label} exited early with status '
+                            f'{self.proc.returncode}; see {self.log_path}')
+
+    def stop(self, timeout=20.0):
+        """SIGINT, wait; return the exit status (killed after timeout)."""
+        if self.proc.poll() is None:
+            self.proc.send_signal(signal.SIGINT)
+        try:
+            self.proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+            self._log.close()
+            return 'killed after SIGINT timeout'
+        self._log.close()
+        return self.proc.returncode
+
+
+class Recorder:
+    """An rclpy node in its own context recording the demo's topics."""
+
+    def __init__(self, domain):
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.qos import (DurabilityPolicy, QoSProfile,
+                               ReliabilityPolicy)
+        from sensor_msgs.msg import JointState
+        from std_msgs.msg import Float64MultiArray, Header
+        self.rclpy = rclpy
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context, domain_id=domain)
+        self.node = rclpy.create_node('demo_recorder', context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+        self.t0 = None
+        self.states = []
+        self.commands = []
+        latched = QoSProfile(depth=1,
+                             reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.node.create_subscription(Header, f'{SIM}/start', self._on_start,
+                                      latched)
+        self.node.create_subscription(JointState, '/joint_states',
+                                      self._on_state, 1000)
+        self.node.create_subscription(Float64MultiArray, f'{SIM}/commands',
+                                      self._on_command, 1000)
+
+    def _on_start(self, msg):
+        self.t0 = msg.stamp.sec + msg.stamp.nanosec * 1e-9
+
+    def _on_state(self, msg):
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        self.states.append((stamp, list(msg.position), list(msg.velocity),
+                            list(msg.effort)))
+
+    def _on_command(self, msg):
+        self.commands.append((time.time(), list(msg.data)))
+
+    def publishers(self, topic):
+        return self.node.count_publishers(topic)
+
+    def subscribers(self, topic):
+        return self.node.count_subscribers(topic)
+
+    def last_time(self):
+        if self.t0 is None or not self.states:
+            return None
+        return self.states[-1][0] - self.t0
+
+    def spin_once(self, timeout=0.02):
+        self.executor.spin_once(timeout_sec=timeout)
+
+    def close(self):
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.rclpy.try_shutdown(context=self.context)
+
+
+def wait_for(recorder, children, predicate, what):
+    """Spin until ``predicate()``; fail if a child exits or on timeout."""
+    end = time.monotonic() + STARTUP_TIMEOUT
+    while not predicate():
+        for child in children:
+            child.check_alive()
+        if time.monotonic() > end:
+            raise DemoError(f'timed out after {STARTUP_TIMEOUT} s waiting '
+                            f'for {what}')
+        recorder.spin_once(0.05)
+
+
+def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
+    """Run the three nodes once; return the recorded arrays."""
+    ff = 'true' if feedforward else 'false'
+    children = []
+    recorder = Recorder(domain)
+    status = {}
+    try:
+        # The simulator waits for a controller; the controller starts last,
+        # once everything else (this recorder too) is up and discovered.
+        children.append(Child(
+            f'{label}_robot_sim_node', 'newton_euler_ros.nodes.'
+            'robot_sim_node', ['-p', f'scene:={scene_arg}',
+                               # this recorder, the controller, the ID node
+                               '-p', 'wait_for_subscribers:=3'],
+            domain, log_dir))
+        children.append(Child(
+            f'{label}_inverse_dynamics_node',
+            'newton_euler_ros.nodes.inverse_dynamics_node',
+            ['-p', f'scene:={scene_arg}',
+             '-p', 'acceleration_source:=reference'], domain, log_dir))
+        wait_for(recorder, children,
+                 lambda: recorder.publishers(f'{ID}/torques') >= 1
+                 and recorder.subscribers(f'{SIM}/commands') >= 1,
+                 'robot_sim_node and inverse_dynamics_node')
+        children.append(Child(
+            f'{label}_tracking_controller_node',
+            'newton_euler_ros.nodes.tracking_controller_node',
+            ['-p', f'scene:={scene_arg}', '-p', f'feedforward:={ff}',
+             '-r', f'reference:={ID}/reference',
+             '-r', f'commands:={SIM}/commands'], domain, log_dir))
+        wait_for(recorder, children, lambda: recorder.t0 is not None,
+                 'the simulation start')
+        print(f'[{label}] nodes up in domain {domain}; simulating '
+              f'{duration:g} s', flush=True)
+        next_report = 1.0
+        end = time.monotonic() + STARTUP_TIMEOUT + 10.0 * duration
+        while True:
+            recorder.spin_once()
+            for child in children:
+                child.check_alive()
+            t = recorder.last_time()
+            if t is not None:
+                while t >= next_report - 1e-9 and next_report <= duration:
+                    print(f'[{label}] t = {next_report:4.1f} s simulated, '
+                          f'{len(recorder.states)} joint states, '
+                          f'{len(recorder.commands)} commands', flush=True)
+                    next_report += 1.0
+                if t >= duration - 1e-9:
+                    break
+            if time.monotonic() > end:
+                raise DemoError(f'[{label}] simulation did not reach '
+                                f't = {duration} s in time')
+    finally:
+        for child in reversed(children):
+            status[child.label] = child.stop()
+        recorder.close()
+    bad = {k: v for k, v in status.items() if v != 0}
+    if bad:
+        raise DemoError(f'[{label}] nodes did not exit cleanly: {bad} '
+                        f'(logs in {log_dir})')
+    print(f'[{label}] stopped: all nodes exited 0', flush=True)
+    if recorder.t0 is None:
+        raise DemoError(f'[{label}] no start time received')
+    stamps = np.array([s[0] for s in recorder.states]) - recorder.t0
+    keep = (stamps >= -1e-9) & (stamps <= duration + 1e-9)
+    order = np.argsort(stamps[keep], kind='stable')
+    rows = [r for r, k in zip(recorder.states, keep) if k]
+    rows = [rows[i] for i in order]
+    return {
+        't': stamps[keep][order],
+        'q': np.array([r[1] for r in rows]),
+        'qd': np.array([r[2] for r in rows]),
+        'tau': np.array([r[3] for r in rows]),
+        'commands': len(recorder.commands),
+    }
+
+
+def tracking(scene, run):
+    """Add the reference and tracking errors to a run; return its RMS."""
+    ref = np.array([scene.reference.at(t)[0] for t in run['t']])
+    run['q_ref'] = ref
+    run['err'] = run['q'] - ref
+    return float(np.sqrt(np.mean(run['err'] ** 2)))
+
+
+def torque_terms(scene, run):
+    """Split the torques of a recorded run into the scene's terms."""
+    from .core import coriolis_matrix, gravity_torques, jacobian, \
+        mass_matrix
+    from .core.simulate import SceneDynamics
+    dyn = SceneDynamics(scene)
+    model, eff = scene.model, scene.effects
+    t, q, qd = run['t'], run['q'], run['qd']
+    qdd = np.gradient(qd, t, axis=0) if len(t) > 2 else np.zeros_like(qd)
+    names = ['D qdd', 'C qd', 'g', 'J^T F', 'friction', 'armature']
+    terms = {k: np.zeros_like(q) for k in names}
+    for k in range(len(t)):
+        terms['D qdd'][k] = mass_matrix(model, q[k]) @ qdd[k]
+        if eff.velocity_products:
+            terms['C qd'][k] = coriolis_matrix(model, q[k], qd[k]) @ qd[k]
+        if eff.gravity:
+            terms['g'][k] = gravity_torques(model, q[k])
+        if eff.wrench:
+            w, frame = dyn.wrench(t[k])
+            terms['J^T F'][k] = jacobian(model, q[k], frame).T @ w
+        if eff.friction:
+            terms['friction'][k] = dyn.friction(qd[k])
+        if eff.armature:
+            terms['armature'][k] = scene.armature * qdd[k]
+    return {k: v for k, v in terms.items()
+            if k == 'D qdd' or np.abs(v).max() > 0.0}
+
+
+def effect_costs(name, quick):
+    """Return bench_effects rows (label, us feedforward, us forward dyn.)."""
+    from .bench_effects import bench_scene
+    with contextlib.redirect_stdout(io.StringIO()):
+        return bench_scene(name, 200 if quick else 2000, 3 if quick else 5)
+
+
+def plots(scene, runs, terms, out):
+    """Write the PNG plots; return their file names."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    joints = scene.model.joint_names
+    n = len(joints)
+    cols = 3
+    rows = (n + cols - 1) // cols
+    files = []
+
+    fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows),
+                             squeeze=False)
+    ff, pd = runs['feedforward'], runs['pd']
+    for j in range(n):
+        ax = axes[j // cols][j % cols]
+        ax.plot(ff['t'], ff['q_ref'][:, j], 'k--', lw=1.2, label='reference')
+        ax.plot(ff['t'], ff['q'][:, j], lw=1.2, label='PD + feedforward')
+        ax.plot(pd['t'], pd['q'][:, j], lw=1.2, label='PD alone')
+        ax.set_title(joints[j])
+        ax.set_xlabel('t [s]')
+        ax.set_ylabel('q [rad]')
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(f'{scene.name}: joint tracking over ROS 2')
+    fig.tight_layout()
+    files.append('joint_tracking.png')
+    fig.savefig(os.path.join(out, files[-1]), dpi=100)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows),
+                             squeeze=False)
+    for j in range(n):
+        ax = axes[j // cols][j % cols]
+        for label, values in terms.items():
+            ax.plot(ff['t'], values[:, j], lw=1.0, label=label)
+        ax.plot(ff['t'], ff['tau'][:, j], 'k', lw=0.8, alpha=0.6,
+                label='applied')
+        ax.set_title(joints[j])
+        ax.set_xlabel('t [s]')
+        ax.set_ylabel('torque [N m]')
+        ax.grid(alpha=0.3)
+    axes[0][0].legend(fontsize=7)
+    fig.suptitle(f'{scene.name}: torques by term (recorded states, '
+                 f'with feedforward)')
+    fig.tight_layout()
+    files.append('torque_terms.png')
+    fig.savefig(os.path.join(out, files[-1]), dpi=100)
+    plt.close(fig)
+
+    fig, axes = plt.subplots(1, 2, figsize=(13, 4))
+    for key, label in (('feedforward', 'PD + feedforward'),
+                       ('pd', 'PD alone')):
+        run = runs[key]
+        axes[0].semilogy(run['t'], np.maximum(
+            np.linalg.norm(run['err'], axis=1), 1e-12), label=label)
+    axes[0].set_xlabel('t [s]')
+    axes[0].set_ylabel('|q - q_ref| [rad]')
+    axes[0].grid(alpha=0.3, which='both')
+    axes[0].legend()
+    width = 0.4
+    x = np.arange(n)
+    for off, key, label in ((-width / 2, 'feedforward', 'PD + feedforward'),
+                            (width / 2, 'pd', 'PD alone')):
+        rms = np.sqrt(np.mean(runs[key]['err'] ** 2, axis=0))
+        axes[1].bar(x + off, rms, width, label=label)
+    axes[1].set_yscale('log')
+    axes[1].set_xticks(x)
+    axes[1].set_xticklabels(joints)
+    axes[1].set_ylabel('RMS error [rad]')
+    axes[1].legend()
+    fig.suptitle(f'{scene.name}: tracking error with and without '
+                 f'feedforward')
+    fig.tight_layout()
+    files.append('tracking_error.png')
+    fig.savefig(os.path.join(out, files[-1]), dpi=100)
+    plt.close(fig)
+    return files
+
+
+def summary(scene, runs, rms, costs, files, duration, wall):
+    """Return summary.md's text."""
+    ratio = rms['pd'] / rms['feedforward'] if rms['feedforward'] > 0 \
+        else float('inf')
+    lines = [
+        f'# Closed-loop demo: {scene.name}',
+        '',
+        f'{scene.description}',
+        '',
+        f'Robot {scene.model.name} ({scene.model.n} joints), '
+        f'{duration:g} s simulated at {scene.rate:g} Hz control over ROS 2 '
+        f'(robot_sim_node -> inverse_dynamics_node -> '
+        f'tracking_controller_node), integrator {scene.integrator} step '
+        f'{scene.step:g} s; wall time {wall:.1f} s.',
+        '',
+        '## Tracking',
+        '',
+        '| controller | RMS error [rad] | max error [rad] | joint states '
+        '| commands |',
+        '|---|---|---|---|---|',
+    ]
+    for key, label in (('feedforward', 'PD + feedforward'),
+                       ('pd', 'PD alone')):
+        run = runs[key]
+        lines.append(f'| {label} | {rms[key]:.3e} | '
+                     f'{np.abs(run["err"]).max():.3e} | {len(run["t"])} | '
+                     f'{run["commands"]} |')
+    lines += [
+        '',
+        f'RMS with feedforward: {rms["feedforward"]:.6e} rad',
+        f'RMS without feedforward: {rms["pd"]:.6e} rad',
+        f'Ratio (without / with): {ratio:.1f}',
+        '',
+        '## Effects',
+        '',
+        f'{", ".join(scene.effects.names()) or "none"}',
+        '',
+        '## Compute cost per effect',
+        '',
+        'Microseconds per call (best of several), from '
+        '`newton_euler_ros.bench_effects`:',
+        '',
+        '| effects | feedforward tau [us] | forward dynamics [us] |',
+        '|---|---|---|',
+    ]
+    lines += [f'| {label} | {t_ff:.2f} | {t_fd:.2f} |'
+              for label, t_ff, t_fd in costs]
+    lines += ['', '## Plots', ''] + [f'![{f}]({f})' for f in files] + ['']
+    return '\n'.join(lines)
+
+
+def main(argv=None):
+    """Run the closed-loop demo; return the exit status."""
+    parser = argparse.ArgumentParser(
+        prog='python -m newton_euler_ros.demo',
+        description='Closed-loop ROS 2 demo: tracking with and without '
+                    'Newton-Euler feedforward.')
+    parser.add_argument('--scene', default=SCENE,
+                        help=f'scene name or file (default {SCENE})')
+    parser.add_argument('--duration', type=float, default=None,
+                        help='seconds of simulated time (default: the '
+                             "scene's duration)")
+    parser.add_argument('--out', default=os.path.join('out', 'demo'),
+                        help='output folder (default out/demo)')
+    parser.add_argument('--quick', action='store_true',
+                        help=f'{QUICK_DURATION:g} s runs, short benchmark')
+    args = parser.parse_args(argv)
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+
+    from .core import NewtonEulerError
+    from .core.scene import load_scene
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            scene = load_scene(args.scene)
+    except NewtonEulerError as exc:
+        print(f'demo: {exc}', file=sys.stderr)
+        return 2
+    # children get an absolute path for a file, the name for a bundled one
+    scene_arg = (os.path.abspath(args.scene) if os.path.isfile(args.scene)
+                 else args.scene)
+    duration = args.duration or (QUICK_DURATION if args.quick
+                                 else scene.duration)
+    duration = min(duration, scene.duration)
+    out = os.path.abspath(args.out)
+    log_dir = os.path.join(out, 'logs')
+    os.makedirs(log_dir, exist_ok=True)
+    base = base_domain()
+    started = time.monotonic()
+    runs, rms = {}, {}
+    try:
+        for k, (key, feedforward) in enumerate((('feedforward', True),
+                                                ('pd', False))):
+            domain = 1 + (base - 1 + k) % 100
+            runs[key] = run_graph(scene_arg, key, feedforward, duration, domain,
+                                  log_dir)
+            if len(runs[key]['t']) < 2:
+                raise DemoError(f'[{key}] too few joint states recorded')
+            rms[key] = tracking(scene, runs[key])
+            print(f'[{key}] tracking RMS error {rms[key]:.3e} rad',
+                  flush=True)
+    except DemoError as exc:
+        print(f'demo: {exc}', file=sys.stderr)
+        return 1
+    wall = time.monotonic() - started
+    terms = torque_terms(scene, runs['feedforward'])
+    costs = effect_costs(args.scene, args.quick)
+    files = plots(scene, runs, terms, out)
+    text = summary(scene, runs, rms, costs, files, duration, wall)
+    with open(os.path.join(out, 'summary.md'), 'w') as fh:
+        fh.write(text)
+    np.savez(os.path.join(out, 'runs.npz'),
+             **{f'{key}_{name}': run[name] for key, run in runs.items()
+                for name in ('t', 'q', 'qd', 'tau', 'q_ref')})
+    ratio = rms['pd'] / rms['feedforward'] if rms['feedforward'] else \
+        float('inf')
+    print(f'RMS with feedforward {rms["feedforward"]:.3e} rad, without '
+          f'{rms["pd"]:.3e} rad (ratio {ratio:.1f}); wrote {out}',
+          flush=True)
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

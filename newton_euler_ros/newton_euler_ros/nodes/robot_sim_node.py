@@ -1,0 +1,257 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+robot_sim_node: a scene's robot simulated in (scaled) real time.
+
+The plant of the closed-loop demo.  Every timer tick advances the scene
+by one control period (1 / rate of simulated time) in sub-steps of the
+scene's integrator step, holding the last torque command (zero-order
+hold), then publishes the state.  Simulated time t maps onto the
+wall-clock stamp ``start + t``; ``~/start`` (latched) carries ``start``
+so that controllers can align their reference.  Once a publisher on
+``~/commands`` exists (``wait_for_controller``) and joint_states has
+``wait_for_subscribers`` matched subscribers, ``start`` is announced
+LEAD seconds ahead, so that the controller and the inverse-dynamics node
+have the reference (and the wrench) before t = 0; and t = 0 is held
+until the first command arrives (at most FIRST_COMMAND seconds: the
+first message over a fresh connection is slow), so the robot does not
+start with a period at zero torque.  Stamps then run that much behind the
+wall clock.  The simulation stops advancing after the scene's duration,
+still publishing.
+
+Subscribes
+    ~/commands (std_msgs/Float64MultiArray: n torques, the model's order)
+Publishes
+    joint_states (sensor_msgs/JointState, effort = applied torque),
+    wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),
+    ~/start (std_msgs/Header, transient local)
+"""
+import math
+import sys
+import time
+
+from geometry_msgs.msg import WrenchStamped
+import numpy as np
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.time import Time
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, Header
+
+from .common import ConfigurationError, qos_profile, run_node
+from ..core import NewtonEulerError
+from ..core.scene import load_scene
+from ..core.simulate import SceneDynamics
+
+FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
+GRACE = 1.0     # seconds between seeing a controller and starting
+LEAD = 0.5      # seconds between announcing the start time and t = 0
+FIRST_COMMAND = 1.0     # seconds t = 0 is held for the first command
+
+
+def advance(dyn, q, qd, tau, t, period, dt, method):
+    """
+    Advance (q, qd) by ``period`` of simulated time from ``t``.
+
+    Sub-steps of at most ``dt`` with the scene's integrator, holding
+    ``tau`` (zero-order hold), as :func:`..core.simulate.simulate` does.
+    Return the new (q, qd).
+    """
+    steps = max(1, int(math.ceil(period / dt - 1e-9)))
+    h = period / steps
+    for k in range(steps):
+        s = t + k * h
+        if method == 'rk4':
+            a1 = dyn.accelerations(q, qd, tau, s)
+            q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
+            a2 = dyn.accelerations(q2, v2, tau, s + 0.5 * h)
+            q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
+            a3 = dyn.accelerations(q3, v3, tau, s + 0.5 * h)
+            q4, v4 = q + h * v3, qd + h * a3
+            a4 = dyn.accelerations(q4, v4, tau, s + h)
+            q = q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4)
+            qd = qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
+        else:   # semi-implicit (symplectic) Euler
+            qd = qd + h * dyn.accelerations(q, qd, tau, s)
+            q = q + h * qd
+    return q, qd
+
+
+class RobotSimNode(Node):
+    """Simulate a scene; torques in on ~/commands, joint states out."""
+
+    def __init__(self, **kwargs):
+        super().__init__('robot_sim_node', **kwargs)
+        name = self.declare_parameter('scene', '').value
+        rtf = self.declare_parameter('real_time_factor', 1.0).value
+        self.wait = self.declare_parameter('wait_for_controller', True).value
+        self.subscribers = self.declare_parameter('wait_for_subscribers',
+                                                  0).value
+        if not name:
+            raise ConfigurationError('scene: must not be empty')
+        if not rtf > 0.0:
+            raise ConfigurationError(f'real_time_factor: must be > 0, got '
+                                     f'{rtf}')
+        try:
+            self.scene = load_scene(name)
+        except NewtonEulerError as exc:
+            raise ConfigurationError(f'scene: {exc}') from None
+        scene = self.scene
+        self.dyn = SceneDynamics(scene)
+        n = scene.model.n
+        self.q = scene.q0.astype(float).copy()
+        self.qd = scene.qd0.astype(float).copy()
+        self.tau = np.zeros(n)       # held command; no torque until one
+        self.applied = np.zeros(n)   # torque of the step just taken
+        self.period = 1.0 / scene.rate
+        self.ticks = 0
+        self.t = 0.0                 # simulated time of the state
+        self.start_ns = None
+        self.started = False
+        self.commanded = False
+        self.first_state_ns = None
+        self.ready_since = None
+        self.dropped = 0
+        self._last_warn = -1e300
+        # compile or load the kernels before the clock starts
+        advance(self.dyn, self.q, self.qd, self.tau, 0.0, scene.step,
+                scene.step, scene.integrator)
+
+        # deep history: a slow reader (a Python recorder) loses nothing
+        qos = qos_profile(100, 'reliable')
+        self.state_pub = self.create_publisher(JointState, 'joint_states',
+                                               qos)
+        self.wrench_pub = (self.create_publisher(WrenchStamped, 'wrench',
+                                                 qos)
+                           if scene.effects.wrench else None)
+        latched = QoSProfile(depth=1,
+                             reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.start_pub = self.create_publisher(Header, '~/start', latched)
+        self.create_subscription(Float64MultiArray, '~/commands',
+                                 self._on_command, qos)
+        self._state = JointState()
+        self._state.name = list(scene.model.joint_names)
+        self._wrench = WrenchStamped()
+        if scene.wrench is not None:
+            self._wrench.header.frame_id = FRAME_IDS[scene.wrench.frame]
+        self.create_timer(self.period / rtf, self._on_tick)
+        self.get_logger().info(
+            f'{scene.name}: {scene.model.name}, {n} joints, effects '
+            f'{scene.effects.names()}, {scene.integrator} step '
+            f'{scene.step} s, {scene.rate} Hz, duration {scene.duration} s, '
+            f'real-time factor {rtf}'
+            + (', waiting for a controller on ~/commands' if self.wait
+               else ''))
+
+    def _on_command(self, msg):
+        data = np.asarray(msg.data, dtype=float)
+        if data.shape != self.tau.shape or not np.isfinite(data).all():
+            self.dropped += 1
+            now = time.monotonic()
+            if now - self._last_warn >= 2.0:
+                self._last_warn = now
+                self.get_logger().warning(
+                    f'dropped command: expected {self.tau.size} finite '
+                    f'torques, got {data.size} values ({self.dropped} '
+                    f'dropped so far); holding the previous command')
+            return
+        self.tau = data
+        self.commanded = True
+
+    def _ready(self):
+        if not self.wait:
+            return True
+        if (self.count_publishers(self.resolve_topic_name('~/commands')) < 1
+                or self.state_pub.get_subscription_count()
+                < self.subscribers):
+            self.ready_since = None
+            return False
+        now = time.monotonic()
+        if self.ready_since is None:
+            self.ready_since = now
+        return now - self.ready_since >= GRACE
+
+    def _on_tick(self):
+        try:
+            self._tick()
+        except Exception:
+            if self.context.ok():
+                raise
+            # shutting down (SIGINT): a publish on the closed context fails
+
+    def _tick(self):
+        now = self.get_clock().now().nanoseconds
+        if self.start_ns is None:
+            if not self._ready():
+                return
+            self.start_ns = now + int(LEAD * 1e9)
+            start = Header(frame_id='sim_start')
+            start.stamp = Time(nanoseconds=self.start_ns).to_msg()
+            self.start_pub.publish(start)
+            self.get_logger().info(f'simulation starts in {LEAD} s')
+        if now < self.start_ns:
+            self._publish_wrench(Time(nanoseconds=now).to_msg())
+            self.started = False
+            return
+        if not self.started:
+            self.started = True
+            self.first_state_ns = now
+            self.get_logger().info(
+                'simulation started (t = 0); joint_states has '
+                f'{self.state_pub.get_subscription_count()} '
+                'subscribers')
+        elif (self.wait and not self.commanded
+              and now - self.first_state_ns < FIRST_COMMAND * 1e9):
+            return      # hold t = 0 until the first command answers it
+        else:
+            self.ticks += 1
+            t_next = self.ticks * self.period
+            if t_next <= self.scene.duration + 1e-9:
+                tau = self.tau
+                self.q, self.qd = advance(self.dyn, self.q, self.qd, tau,
+                                          self.t, self.period,
+                                          self.scene.step,
+                                          self.scene.integrator)
+                self.t = t_next
+                self.applied = tau
+        stamp = Time(nanoseconds=self.start_ns
+                     + int(round(self.ticks * self.period * 1e9))).to_msg()
+        self._publish_wrench(stamp)     # first: the torques need it
+        msg = self._state
+        msg.header.stamp = stamp
+        msg.position = self.q.tolist()
+        msg.velocity = self.qd.tolist()
+        msg.effort = self.applied.tolist()
+        self.state_pub.publish(msg)
+
+    def _publish_wrench(self, stamp):
+        if self.wrench_pub is None:
+            return
+        w = self.scene.wrench.at(self.t)
+        m = self._wrench
+        m.header.stamp = stamp
+        f, tq = m.wrench.force, m.wrench.torque
+        f.x, f.y, f.z, tq.x, tq.y, tq.z = (float(x) for x in w)
+        self.wrench_pub.publish(m)
+
+
+def main(args=None):
+    """Entry point of the ``robot_sim_node`` console script."""
+    return run_node(RobotSimNode, 'robot_sim_node', args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,239 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+tracking_controller_node: PD on a scene's reference plus feedforward.
+
+Once the simulator's start time t0 is known (latched ``/robot_sim_node/
+start``), the node publishes the scene's reference on ``reference``
+(remap it to ``/inverse_dynamics_node/reference``) and, for every joint
+state, commands
+
+    tau = kp (q_d - q) + kd (qd_d - qd) + ff
+
+with (q_d, qd_d) the reference at t = stamp - t0 and ff the inverse-
+dynamics node's torques for the same stamp (the node waits for them).
+With ``feedforward`` false, ff = 0 and every state is answered at once.
+
+Subscribes
+    joint_states (sensor_msgs/JointState), /robot_sim_node/start
+    (std_msgs/Header, transient local), feedforward_topic
+    (sensor_msgs/JointState, only with feedforward)
+Publishes
+    commands (std_msgs/Float64MultiArray), reference
+    (trajectory_msgs/JointTrajectory)
+"""
+from collections import OrderedDict
+import sys
+
+from builtin_interfaces.msg import Duration
+import numpy as np
+from rclpy.node import Node
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Float64MultiArray, Header
+from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+
+from .common import ConfigurationError, qos_profile, run_node
+from ..core import NewtonEulerError
+from ..core.scene import load_scene
+
+SAMPLE = 0.01           # reference sampling period, seconds
+PENDING = 32            # joint states / feedforward kept for matching
+REPUBLISH = 0.1         # seconds between checks to republish the reference
+
+
+def _key(stamp):
+    return (stamp.sec, stamp.nanosec)
+
+
+def _seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+def reference_message(scene, names, t0_stamp, sample=SAMPLE):
+    """Return the scene's reference as a JointTrajectory starting at t0."""
+    msg = JointTrajectory()
+    msg.header.stamp = t0_stamp
+    msg.joint_names = list(names)
+    steps = int(round(scene.duration / sample))
+    for k in range(steps + 1):
+        t = k * sample
+        q, qd, qdd = scene.reference.at(t)
+        sec = int(t)
+        msg.points.append(JointTrajectoryPoint(
+            positions=[float(x) for x in q],
+            velocities=[float(x) for x in qd],
+            accelerations=[float(x) for x in qdd],
+            time_from_start=Duration(sec=sec,
+                                     nanosec=int(round((t - sec) * 1e9)))))
+    return msg
+
+
+class TrackingControllerNode(Node):
+    """PD tracking of a scene's reference, with inverse-dynamics torques."""
+
+    def __init__(self, **kwargs):
+        super().__init__('tracking_controller_node', **kwargs)
+        name = self.declare_parameter('scene', '').value
+        self.use_ff = self.declare_parameter('feedforward', True).value
+        ff_topic = self.declare_parameter(
+            'feedforward_topic', '/inverse_dynamics_node/torques').value
+        if not name:
+            raise ConfigurationError('scene: must not be empty')
+        try:
+            self.scene = load_scene(name)
+        except NewtonEulerError as exc:
+            raise ConfigurationError(f'scene: {exc}') from None
+        self.names = list(self.scene.model.joint_names)
+        self.n = len(self.names)
+        self.t0 = None
+        self.t0_stamp = None
+        self.states = OrderedDict()     # stamp -> (t, q, qd)
+        self.ffs = OrderedDict()        # stamp -> ff
+        self.published = 0
+        self._index = {}
+        self._ref_msg = None
+        self._ref_count = 0
+
+        qos = qos_profile(10, 'reliable')
+        latched = QoSProfile(depth=1,
+                             reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self.cmd_pub = self.create_publisher(Float64MultiArray, 'commands',
+                                             qos)
+        self.ref_pub = self.create_publisher(JointTrajectory, 'reference',
+                                             10)
+        self.create_subscription(Header, '/robot_sim_node/start',
+                                 self._on_start, latched)
+        self.create_subscription(JointState, 'joint_states', self._on_state,
+                                 qos)
+        if self.use_ff:
+            self.create_subscription(JointState, ff_topic, self._on_ff, qos)
+        self.create_timer(REPUBLISH, self._publish_reference)
+        self._cmd = Float64MultiArray()
+        self.get_logger().info(
+            f'{self.scene.name}: PD on {self.n} joints'
+            + (f' + feedforward from {ff_topic}' if self.use_ff else
+               ' alone (no feedforward)'))
+
+    def _gather(self, names, values, what):
+        """Return ``values`` in the model's joint order."""
+        names = tuple(names)
+        if names == tuple(self.names) or not names:
+            if len(values) != self.n:
+                raise ValueError(f'{what}: expected {self.n} values')
+            return np.asarray(values, dtype=float)
+        idx = self._index.get(names)
+        if idx is None:
+            idx = [names.index(j) for j in self.names]
+            self._index[names] = idx
+        return np.asarray(values, dtype=float)[idx]
+
+    def _on_start(self, msg):
+        t0 = _seconds(msg.stamp)
+        if t0 != self.t0:
+            self.t0, self.t0_stamp = t0, msg.stamp
+            self._ref_msg = None
+            self.states.clear()
+            self.ffs.clear()
+            self.get_logger().info(f'simulation start t0 = {t0:.6f}')
+            self._publish_reference()
+
+    def _publish_reference(self):
+        """
+        Publish the reference: at t0, then to each new subscriber.
+
+        Copies go out before t = 0 and on a new subscription only: a
+        copy is large, and building and converting it stalls both nodes
+        for milliseconds.
+        """
+        if self.t0_stamp is None or not self.context.ok():
+            return
+        count = self.ref_pub.get_subscription_count()
+        now = self.get_clock().now().nanoseconds * 1e-9
+        if self._ref_msg is None:
+            self._ref_msg = reference_message(self.scene, self.names,
+                                              self.t0_stamp)
+        elif count <= self._ref_count and now > self.t0:
+            return
+        self._ref_count = count
+        self.ref_pub.publish(self._ref_msg)
+
+    def _on_state(self, msg):
+        if self.t0 is None:
+            return
+        try:
+            q = self._gather(msg.name, msg.position, 'position')
+            qd = self._gather(msg.name, msg.velocity, 'velocity')
+        except (ValueError, IndexError) as exc:
+            self.get_logger().warning(f'dropped joint state: {exc}',
+                                      throttle_duration_sec=2.0)
+            return
+        key = _key(msg.header.stamp)
+        t = _seconds(msg.header.stamp) - self.t0
+        if not self.use_ff:
+            self._command(t, q, qd, np.zeros(self.n))
+            return
+        ff = self.ffs.pop(key, None)
+        if ff is not None:
+            self._command(t, q, qd, ff)
+            return
+        self.states[key] = (t, q, qd)
+        while len(self.states) > PENDING:
+            self.states.popitem(last=False)
+
+    def _on_ff(self, msg):
+        try:
+            ff = self._gather(msg.name, msg.effort, 'effort')
+        except (ValueError, IndexError) as exc:
+            self.get_logger().warning(f'dropped feedforward: {exc}',
+                                      throttle_duration_sec=2.0)
+            return
+        key = _key(msg.header.stamp)
+        state = self.states.pop(key, None)
+        if state is None:
+            self.ffs[key] = ff
+            while len(self.ffs) > PENDING:
+                self.ffs.popitem(last=False)
+            return
+        # states older than this one will not be answered any more
+        for old in [k for k in self.states if k < key]:
+            del self.states[old]
+        self._command(*state, ff)
+
+    def _command(self, t, q, qd, ff):
+        q_d, qd_d, _ = self.scene.reference.at(t)
+        tau = self.scene.kp * (q_d - q) + self.scene.kd * (qd_d - qd) + ff
+        if not np.isfinite(tau).all():
+            self.get_logger().warning('non-finite torque; not sent',
+                                      throttle_duration_sec=2.0)
+            return
+        self._cmd.data = tau.tolist()
+        try:
+            self.cmd_pub.publish(self._cmd)
+        except Exception:
+            if self.context.ok():
+                raise
+            return      # shutting down (SIGINT): the context is closed
+        self.published += 1
+
+
+def main(args=None):
+    """Entry point of the ``tracking_controller_node`` console script."""
+    return run_node(TrackingControllerNode, 'tracking_controller_node', args)
+
+
+if __name__ == '__main__':
+    sys.exit(main())

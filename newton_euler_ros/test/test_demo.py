@@ -1,0 +1,58 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The closed-loop demo, quick mode, as a subprocess.
+
+Simulator, inverse-dynamics node and tracking controller run as real
+processes on loopback DDS, with and without feedforward; the demo stops
+them with SIGINT and fails unless they all exit 0.
+"""
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip('rclpy')
+
+from ros_harness import domain_id, ros_env  # noqa: E402, I100
+
+pytestmark = pytest.mark.ros
+
+PLOTS = ('joint_tracking.png', 'torque_terms.png', 'tracking_error.png')
+
+
+def _rms(text, label):
+    match = re.search(rf'RMS {label} feedforward: (\S+) rad', text)
+    assert match, f'no "RMS {label} feedforward" line in summary.md'
+    return float(match.group(1))
+
+
+def test_quick_demo(tmp_path):
+    out = tmp_path / 'demo'
+    proc = subprocess.run(
+        [sys.executable, '-m', 'newton_euler_ros.demo', '--quick', '--out',
+         str(out)],
+        env=ros_env(domain_id(61)), capture_output=True, text=True,
+        timeout=180)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert 'all nodes exited 0' in proc.stdout
+    assert proc.stdout.count('all nodes exited 0') == 2
+    for name in PLOTS + ('summary.md',):
+        assert os.path.getsize(out / name) > 0, name
+    text = (out / 'summary.md').read_text()
+    with_ff, without = _rms(text, 'with'), _rms(text, 'without')
+    assert 0.0 < with_ff < without
