@@ -96,7 +96,8 @@ def main(argv=None):
                                      description=__doc__.strip().split(
                                          '\n')[0])
     parser.add_argument('scenes', nargs='*',
-                        default=['puma_payload_press', 'panda_orbit_slow'])
+                        default=['puma_payload_press', 'panda_orbit_slow',
+                                 'panda_slow_earth'])
     parser.add_argument('--quick', action='store_true',
                         help='fewer repetitions')
     args = parser.parse_args(argv)
