@@ -29,6 +29,7 @@ import os
 import signal
 import sys
 
+from rcl_interfaces.msg import ParameterDescriptor
 import rclpy
 from rclpy.executors import ExternalShutdownException, \
     SingleThreadedExecutor
@@ -44,6 +45,12 @@ def qos_profile(depth, reliability):
     return QoSProfile(depth=depth, reliability=(
         ReliabilityPolicy.RELIABLE if reliability == 'reliable'
         else ReliabilityPolicy.BEST_EFFORT))
+
+
+def declare(node, name, default, description):
+    """Declare a parameter with a description; return its value."""
+    return node.declare_parameter(
+        name, default, ParameterDescriptor(description=description)).value
 
 
 def make_executor():

@@ -50,7 +50,7 @@ from rclpy.time import Time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 
-from .common import ConfigurationError, qos_profile, run_node
+from .common import ConfigurationError, declare, qos_profile, run_node
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
 from ..core.simulate import SceneDynamics
@@ -94,11 +94,16 @@ class RobotSimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('robot_sim_node', **kwargs)
-        name = self.declare_parameter('scene', '').value
-        rtf = self.declare_parameter('real_time_factor', 1.0).value
-        self.wait = self.declare_parameter('wait_for_controller', True).value
-        self.subscribers = self.declare_parameter('wait_for_subscribers',
-                                                  0).value
+        name = declare(self, 'scene', '',
+                       'Scene YAML file or bundled scene name to simulate.')
+        rtf = declare(self, 'real_time_factor', 1.0,
+                      'Simulated seconds per wall-clock second (> 0).')
+        self.wait = declare(self, 'wait_for_controller', True,
+                            'Hold t = 0 until a publisher on ~/commands '
+                            'exists.')
+        self.subscribers = declare(self, 'wait_for_subscribers', 0,
+                                   'Hold t = 0 until joint_states has this '
+                                   'many matched subscribers.')
         if not name:
             raise ConfigurationError('scene: must not be empty')
         if not rtf > 0.0:

@@ -45,7 +45,7 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from .common import ConfigurationError, qos_profile, run_node
+from .common import ConfigurationError, declare, qos_profile, run_node
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
 
@@ -86,10 +86,16 @@ class TrackingControllerNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('tracking_controller_node', **kwargs)
-        name = self.declare_parameter('scene', '').value
-        self.use_ff = self.declare_parameter('feedforward', True).value
-        ff_topic = self.declare_parameter(
-            'feedforward_topic', '/inverse_dynamics_node/torques').value
+        name = declare(self, 'scene', '',
+                       'Scene YAML file or bundled scene name: reference, '
+                       'gains.')
+        self.use_ff = declare(self, 'feedforward', True,
+                              'Add the inverse-dynamics torques for the '
+                              'same stamp (false: PD alone).')
+        ff_topic = declare(self, 'feedforward_topic',
+                           '/inverse_dynamics_node/torques',
+                           'sensor_msgs/JointState topic of the '
+                           'feedforward torques.')
         if not name:
             raise ConfigurationError('scene: must not be empty')
         try:
