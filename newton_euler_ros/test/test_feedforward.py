@@ -144,16 +144,22 @@ def test_computer_matches_library_with_reference_and_wrench(puma):
 def test_scene_selects_the_nodes_effects():
     from newton_euler_ros.core.scene import load_scene
     from newton_euler_ros.core.simulate import SceneDynamics
-    orbit = load_scene('panda_orbit_slow')       # no gravity, no qd terms
+    orbit = load_scene('panda_orbit_slow')       # no gravity
     order = JointOrder(orbit.model.joint_names)
     ff = FeedforwardComputer(None, order, WrenchInput([], []), None, orbit)
     names = list(orbit.model.joint_names)
     q = orbit.q0
-    tau = ff.torques(names, q, np.full(7, 0.5), stamp=0.0, now=0.0)
+    tau = ff.torques(names, q, np.zeros(7), stamp=0.0, now=0.0)
     assert np.all(tau == 0.0)                    # at rest in orbit: nothing
     D, C, g, t = ff.terms(names, q, np.full(7, 0.5), np.ones(7), now=0.0)
-    assert np.all(C == 0.0) and np.all(g == 0.0)
-    np.testing.assert_allclose(t, D @ np.ones(7), rtol=0, atol=1e-12)
+    assert np.all(g == 0.0) and np.abs(C).max() > 0.0
+    np.testing.assert_allclose(t, D @ np.ones(7) + C @ np.full(7, 0.5),
+                               rtol=0, atol=1e-12)
+    slow = load_scene('panda_slow_earth')        # no velocity products
+    ff = FeedforwardComputer(None, order, WrenchInput([], []), None, slow)
+    D, C, g, t = ff.terms(names, q, np.full(7, 0.5), np.ones(7), now=0.0)
+    assert np.all(C == 0.0) and np.abs(g).max() > 1.0
+    np.testing.assert_allclose(t, D @ np.ones(7) + g, rtol=0, atol=1e-12)
     press = load_scene('puma_payload_press')     # every effect
     order = JointOrder(press.model.joint_names)
     ff = FeedforwardComputer(None, order, WrenchInput([], []), None, press)
