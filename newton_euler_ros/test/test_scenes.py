@@ -260,3 +260,22 @@ def test_effect_benchmark_runs(capsys):
     assert bench_effects.main(['puma_payload_press', '--quick']) == 0
     out = capsys.readouterr().out
     assert 'without friction' in out and 'none (D qdd only)' in out
+
+
+def test_live_wrench_equals_constant_wrench():
+    """A topic-fed wrench, once set, acts exactly like a constant one."""
+    data, folder = bundled('puma_payload_press')
+    live = copy.deepcopy(data)
+    live['effects']['wrench'] = {'frame': 'end_effector', 'source': 'topic'}
+    const = copy.deepcopy(data)
+    w = [1.0, -2.0, 30.0, 0.1, 0.2, -0.3]
+    const['effects']['wrench'] = {'frame': 'end_effector', 'constant': w}
+    d_live = SceneDynamics(scene_from_dict(live, 'l.yaml', folder))
+    d_const = SceneDynamics(scene_from_dict(const, 'c.yaml', folder))
+    q, qd, tau = np.full(6, 0.3), np.full(6, -0.2), np.ones(6)
+    offline = d_live.accelerations(q, qd, tau, 0.0)     # zero until set
+    d_live.live_wrench = np.array(w)
+    np.testing.assert_array_equal(d_live.accelerations(q, qd, tau, 0.0),
+                                  d_const.accelerations(q, qd, tau, 0.0))
+    assert np.abs(offline - d_const.accelerations(q, qd, tau, 0.0)).max() \
+        > 1e-3

@@ -49,11 +49,22 @@ class SceneDynamics:
         self._L = np.zeros((n, n))
         self._qdd = np.zeros(n)
         self._D = np.zeros((n, n))
+        self.live_wrench = np.zeros(6)
+        self.live_frame = (scene.wrench.frame if scene.wrench is not None
+                           else 'base')
 
     def wrench(self, t):
-        """(wrench or None, frame) at time t."""
+        """
+        Return (wrench or None, frame) at time t.
+
+        A scene whose wrench comes from a topic uses ``live_wrench`` and
+        ``live_frame``, which a ROS adapter keeps up to date (zero
+        offline).
+        """
         if not self.effects.wrench:
             return None, 'base'
+        if self.scene.wrench.kind == 'topic':
+            return self.live_wrench, self.live_frame
         return self.scene.wrench.at(t), self.scene.wrench.frame
 
     def friction(self, qd):

@@ -56,6 +56,8 @@ from ..core.scene import load_scene
 from ..core.simulate import SceneDynamics
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
+FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
+            'end_effector': 'end_effector', 'ee_link': 'end_effector'}
 GRACE = 1.0     # seconds between seeing a controller and starting
 LEAD = 0.5      # seconds between announcing the start time and t = 0
 FIRST_COMMAND = 1.0     # seconds t = 0 is held for the first command
@@ -138,9 +140,14 @@ class RobotSimNode(Node):
         qos = qos_profile(100, 'reliable')
         self.state_pub = self.create_publisher(JointState, 'joint_states',
                                                qos)
+        live = scene.effects.wrench and scene.wrench.kind == 'topic'
+        # a scheduled wrench is published; a live one is read from the topic
         self.wrench_pub = (self.create_publisher(WrenchStamped, 'wrench',
                                                  qos)
-                           if scene.effects.wrench else None)
+                           if scene.effects.wrench and not live else None)
+        if live:
+            self.create_subscription(WrenchStamped, 'wrench',
+                                     self._on_wrench, qos)
         latched = QoSProfile(depth=1,
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
@@ -241,6 +248,21 @@ class RobotSimNode(Node):
         msg.velocity = self.qd.tolist()
         msg.effort = self.applied.tolist()
         self.state_pub.publish(msg)
+
+    def _on_wrench(self, msg):
+        """Apply a live wrench (frame_id base_link/base or tool0/...)."""
+        frame = FRAME_OF.get(msg.header.frame_id)
+        f, n = msg.wrench.force, msg.wrench.torque
+        w = np.array([f.x, f.y, f.z, n.x, n.y, n.z])
+        if frame is None or not np.isfinite(w).all():
+            self.dropped += 1
+            self.get_logger().warning(
+                f'dropped wrench in frame {msg.header.frame_id!r} '
+                f'(frames: {sorted(FRAME_OF)}) or non-finite: {w.tolist()}',
+                throttle_duration_sec=2.0)
+            return
+        self.dyn.live_wrench = w
+        self.dyn.live_frame = frame
 
     def _publish_wrench(self, stamp):
         if self.wrench_pub is None:
