@@ -31,13 +31,13 @@ import argparse
 import contextlib
 import io
 import os
-import signal
-import subprocess
 import sys
 import time
 import warnings
 
 import numpy as np
+
+from .processes import ChildProcess
 
 SCENE = 'puma_payload_press'
 QUICK_DURATION = 1.0
@@ -50,15 +50,6 @@ class DemoError(Exception):
     """The demo could not run to completion."""
 
 
-def child_env(domain):
-    """Return this environment plus a domain id and localhost discovery."""
-    env = dict(os.environ)      # LD_LIBRARY_PATH inherited, never replaced
-    env['ROS_DOMAIN_ID'] = str(domain)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
 def base_domain():
     """Return the first domain id to use (from ROS_DOMAIN_ID, else pid)."""
     value = os.environ.get('ROS_DOMAIN_ID', '')
@@ -67,36 +58,19 @@ def base_domain():
     return 1 + os.getpid() % 100
 
 
-class Child:
-    """A node process with its output in a log file."""
+class Child(ChildProcess):
+    """A node run as ``python -m module --ros-args ...``."""
 
     def __init__(self, label, module, ros_args, domain, log_dir):
-        self.label = label
-        self.log_path = os.path.join(log_dir, f'{label}.log')
-        self._log = open(self.log_path, 'w')
-        cmd = [sys.executable, '-m', module, '--ros-args', *ros_args]
-        self.proc = subprocess.Popen(cmd, env=child_env(domain),
-                                     stdout=self._log,
-                                     stderr=subprocess.STDOUT)
+        super().__init__([sys.executable, '-m', module, '--ros-args',
+                          *ros_args], domain,
+                         os.path.join(log_dir, f'{label}.log'), label)
 
     def check_alive(self):
-        if self.proc.poll() is not None:
+        """Raise DemoError when the process has already exited."""
+        if not self.alive():
             raise DemoError(f'{self.label} exited early with status '
                             f'{self.proc.returncode}; see {self.log_path}')
-
-    def stop(self, timeout=20.0):
-        """SIGINT, wait; return the exit status (killed after timeout)."""
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT)
-        try:
-            self.proc.wait(timeout)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
-            self._log.close()
-            return 'killed after SIGINT timeout'
-        self._log.close()
-        return self.proc.returncode
 
 
 class Recorder:

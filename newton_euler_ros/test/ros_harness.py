@@ -20,10 +20,9 @@ localhost.  The node under test runs as its own process through its
 console script; the test talks to it from a separate rclpy context.
 """
 import os
-import signal
-import subprocess
-import sys
 import time
+
+from newton_euler_ros.processes import ChildProcess, ros_env  # noqa: F401
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PARAMS_DIR = os.path.join(PACKAGE_DIR, 'config', 'params')
@@ -34,52 +33,8 @@ def domain_id(offset):
     return 1 + (os.getpid() * 7 + offset) % 100
 
 
-def ros_env(domain):
-    """
-    Return this process's environment with ROS traffic kept on loopback.
-
-    LD_LIBRARY_PATH is inherited untouched (the ROS wheels' bootstrap set
-    it; replacing it would break rclpy in the child).
-    """
-    env = dict(os.environ)
-    env['ROS_DOMAIN_ID'] = str(domain)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
-def node_command(module, *ros_args):
-    """Run a node module with this interpreter (same venv as the test)."""
-    return [sys.executable, '-m', module, '--ros-args', *ros_args]
-
-
-class NodeProcess:
-    """A node started as a child process; stop() sends SIGINT."""
-
-    def __init__(self, cmd, domain, log_path):
-        self.log_path = log_path
-        self._log = open(log_path, 'w')
-        self.proc = subprocess.Popen(cmd, env=ros_env(domain),
-                                     stdout=self._log,
-                                     stderr=subprocess.STDOUT)
-
-    def log(self):
-        if not self._log.closed:
-            self._log.flush()
-        with open(self.log_path) as fh:
-            return fh.read()
-
-    def stop(self, timeout=15.0):
-        """SIGINT, wait, return the exit code (kills after the timeout)."""
-        if self.proc.poll() is None:
-            self.proc.send_signal(signal.SIGINT)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.proc.kill()
-                self.proc.wait()
-        self._log.close()
-        return self.proc.returncode
+# the node under test runs as a child process; stop() sends SIGINT
+NodeProcess = ChildProcess
 
 
 class Probe:
