@@ -185,6 +185,11 @@ class WrenchInput:
             raise InputRejected(
                 'stale', f'wrench is {now - stamp:.3f} s old (timeout '
                 f'{self.timeout} s)')
+        if self.timeout and stamp - now > self.timeout:
+            # a clock running ahead would otherwise keep it applied forever
+            raise InputRejected(
+                'stale', f'wrench is stamped {stamp - now:.3f} s in the '
+                f'future (timeout {self.timeout} s)')
         self.wrench = self.sign * w
         self.frame = frame
         self.stamp = stamp
@@ -305,12 +310,12 @@ class FeedforwardComputer:
             qd = np.zeros(self.model.n)
         qdd = (self.reference.acceleration(stamp)
                if self.reference is not None else None)
-        self.last_q, self.last_qd = q, qd
         w, frame = self.wrench.current(now)
         tau = self._torques(q, qd, qdd, w, frame, out=self.tau)
         if not np.isfinite(tau).all():   # finite input; guard the output
             raise InputRejected('non_finite', 'dynamics produced a '
                                 'non-finite torque')
+        self.last_q, self.last_qd = q, qd   # only usable states count
         return self.order.to_output_order(tau)
 
     def terms(self, names, position, velocity, acceleration, now):

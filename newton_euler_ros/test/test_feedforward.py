@@ -172,3 +172,15 @@ def test_scene_selects_the_nodes_effects():
         warnings.simplefilter('ignore')
         bare = inverse_dynamics(load_robot('puma560'), q, qd)
     assert np.abs(got - bare).max() > 0.1        # payload + friction count
+
+
+def test_future_wrench_rejected_and_bad_state_not_remembered(puma):
+    w = WrenchInput(['base_link'], [], timeout=0.5)
+    with pytest.raises(InputRejected, match='in the future') as info:
+        w.update('base_link', [1.0] * 6, stamp=100.0, now=10.0)
+    assert info.value.kind == 'stale' and w.current(10.0)[0] is None
+    order = JointOrder(puma.joint_names)
+    ff = FeedforwardComputer(puma, order, WrenchInput([], []))
+    with pytest.raises(InputRejected, match='non-finite torque'):
+        ff.torques(names6(), np.zeros(6), np.full(6, 1e308), 0.0, 0.0)
+    assert ff.last_q is None          # a rejected state is not "latest"
