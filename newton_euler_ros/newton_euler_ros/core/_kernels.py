@@ -69,7 +69,9 @@ L_THETA = 6      # theta offset
 L_MASS = 7
 L_COM = 8        # 3 columns
 L_INERTIA = 11   # 9 columns, row-major, about the com in link-frame axes
-L_WIDTH = 20
+L_CT0 = 20       # cos(theta offset)
+L_ST0 = 21       # sin(theta offset)
+L_WIDTH = 22
 
 # Rows of the fixed-frame array ``frames`` (shape (3, 12)).
 F_BASE = 0       # R (9, row-major) then p (3): DH frame 0 in the base frame
@@ -101,18 +103,28 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 @njit(cache=True)
 def joint_trig(links, q, ws):
-    """Fill cos(theta_j), sin(theta_j), d_j of every joint into ``ws``."""
+    """
+    Fill cos(theta_j), sin(theta_j), d_j of every joint into ``ws``.
+
+    A revolute angle is q + theta_offset; its cosine and sine come from
+    the angle-addition formulas with the offset's cosine and sine computed
+    once, so a large q is not first rounded by the sum (q + offset would
+    lose |q| eps).  A prismatic joint needs no trigonometry per call.
+    """
     n = links.shape[0]
     for j in range(n):
-        th = links[j, L_THETA]
-        dd = links[j, L_D]
+        ct0 = links[j, L_CT0]
+        st0 = links[j, L_ST0]
         if links[j, L_TYPE] == 0.0:
-            th = th + q[j]
+            cq = math.cos(q[j])
+            sq = math.sin(q[j])
+            ws[j, W_CT] = cq * ct0 - sq * st0
+            ws[j, W_ST] = sq * ct0 + cq * st0
+            ws[j, W_DD] = links[j, L_D]
         else:
-            dd = dd + q[j]
-        ws[j, W_CT] = math.cos(th)
-        ws[j, W_ST] = math.sin(th)
-        ws[j, W_DD] = dd
+            ws[j, W_CT] = ct0
+            ws[j, W_ST] = st0
+            ws[j, W_DD] = links[j, L_D] + q[j]
 
 
 @njit(cache=True)

@@ -123,6 +123,8 @@ class RobotModel:
             links[j, K.L_SA] = math.sin(self.alpha[j])
             links[j, K.L_D] = self.d[j]
             links[j, K.L_THETA] = self.theta[j]
+            links[j, K.L_CT0] = math.cos(self.theta[j])
+            links[j, K.L_ST0] = math.sin(self.theta[j])
             links[j, K.L_MASS] = self.mass[j]
             links[j, K.L_COM:K.L_COM + 3] = self.com[j]
             links[j, K.L_INERTIA:K.L_INERTIA + 9] = self.inertia[j].ravel()
