@@ -33,8 +33,8 @@ import math
 
 import numpy as np
 
-from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
-                   mass_matrix, Workspace)
+from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
+                   inverse_dynamics, mass_matrix, Workspace)
 from .core.simulate import SceneDynamics
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
@@ -281,10 +281,14 @@ class FeedforwardComputer:
 
     def _torques(self, q, qd, qdd, w, frame, out=None):
         """Inverse dynamics with the scene's effects, or all of them."""
-        if self.dyn is not None:
-            return self.dyn.torques_for_wrench(q, qd, qdd, w, frame, out=out)
-        return inverse_dynamics(self.model, q, qd, qdd, w, frame, ws=self.ws,
-                                out=out)
+        try:
+            if self.dyn is not None:
+                return self.dyn.torques_for_wrench(q, qd, qdd, w, frame,
+                                                   out=out)
+            return inverse_dynamics(self.model, q, qd, qdd, w, frame,
+                                    ws=self.ws, out=out)
+        except DynamicsInputError as exc:   # finite input that overflows
+            raise InputRejected('non_finite', str(exc)) from None
 
     def warm_up(self):
         """

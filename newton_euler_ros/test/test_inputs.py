@@ -104,3 +104,15 @@ def test_condition_number_of_d(arm):
     root = math.sqrt(((a - c) / 2) ** 2 + b * b)
     expected = ((a + c) / 2 + root) / ((a + c) / 2 - root)
     assert mass_matrix_condition(arm, q) == pytest.approx(expected, rel=1e-12)
+
+
+@pytest.mark.parametrize('call', [
+    lambda m: inverse_dynamics(m, [0.0, 0.0], [1e200, 1e200]),
+    lambda m: inverse_dynamics_batch(m, np.zeros((2, 2)),
+                                     np.full((2, 2), 1e200)),
+    lambda m: forward_dynamics(m, [0.0, 0.0], [1e200, 1e200], [0.0, 0.0]),
+])
+def test_finite_input_that_overflows_raises(arm, call):
+    """Finite input never yields NaN/Inf: an overflow is a clear error."""
+    with pytest.raises(DynamicsInputError, match='overflows float64'):
+        call(arm)

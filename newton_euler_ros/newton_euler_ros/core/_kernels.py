@@ -90,6 +90,9 @@ W_ST = 25        # sin(theta_j)
 W_DD = 26        # d_j
 W_WIDTH = 27
 
+# Returned when finite inputs overflow float64 in the result.
+OVERFLOW = 9000
+
 # Wrench modes.
 WRENCH_NONE = 0
 WRENCH_BASE = 1
@@ -420,6 +423,8 @@ def inverse_dynamics(links, frames, q, qd, qdd, wrench, gravity_on,
     joint_trig(links, q, ws)
     recursion(links, frames, qd, qd, qdd, wrench, gravity_on, velocity_on,
               wrench_mode, ws, tau)
+    if first_nonfinite(tau) >= 0:
+        return OVERFLOW
     return -1
 
 

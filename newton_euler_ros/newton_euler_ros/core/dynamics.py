@@ -112,10 +112,21 @@ def _vector(name, x, size):
 
 
 def _raise_nonfinite(code, values):
+    if code == K.OVERFLOW:
+        raise DynamicsInputError(
+            'the result overflows float64 (inputs too large); nothing is '
+            'returned')
     arg, i = divmod(code, 1000)
     name = _ARG_NAMES[arg]
     raise DynamicsInputError(
         f'{name}[{i}] is {float(values[arg][i])!r}; every entry must be finite')
+
+
+def _finite_result(x):
+    """Return x, or raise if finite inputs overflowed float64 in it."""
+    if not np.isfinite(x).all():
+        _raise_nonfinite(K.OVERFLOW, ())
+    return x
 
 
 def _check_finite(q, qd, qdd, wrench):
@@ -216,7 +227,7 @@ def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
     K.inverse_dynamics_batch(model.links_array, model.frames_array, Q, QD,
                              QDD, W, gravity, velocity_products, mode, ws.ws,
                              TAU)
-    return TAU
+    return _finite_result(TAU)
 
 
 def _matrix(name, X, cols, rows=None):
@@ -245,7 +256,7 @@ def mass_matrix(model, q, *, ws=None, out=None):
     D = np.empty((ws.n, ws.n)) if out is None else out
     K.mass_matrix(model.links_array, model.frames_array, q, ws.ws,
                   ws.scratch, D)
-    return D
+    return _finite_result(D)
 
 
 def mass_matrix_condition(model, q, *, ws=None):
@@ -277,7 +288,7 @@ def coriolis_matrix(model, q, qd, *, ws=None, out=None):
     C = np.empty((ws.n, ws.n)) if out is None else out
     K.coriolis_matrix(model.links_array, model.frames_array, q, qd, ws.ws,
                       ws.scratch, C)
-    return C
+    return _finite_result(C)
 
 
 def velocity_products(model, q, qd, *, ws=None, out=None):
