@@ -479,6 +479,7 @@ def mass_matrix(links, frames, q, ws, scratch, D):
             avg = 0.5 * (D[i, k] + D[k, i])
             D[i, k] = avg
             D[k, i] = avg
+    return _matrix_status(D)
 
 
 @njit(cache=True)
@@ -486,6 +487,16 @@ def coriolis_matrix(links, frames, q, qd, ws, scratch, C):
     """Christoffel C(q, qd) column by column: C e_k = Y(q, qd, e_k, 0)."""
     joint_trig(links, q, ws)
     _unit_columns(links, frames, qd, True, ws, scratch, C)
+    return _matrix_status(C)
+
+
+@njit(cache=True)
+def _matrix_status(M):
+    """Return -1 when every entry is finite, else OVERFLOW."""
+    for i in range(M.shape[0]):
+        if first_nonfinite(M[i]) >= 0:
+            return OVERFLOW
+    return -1
 
 
 @njit(cache=True)

@@ -254,9 +254,10 @@ def mass_matrix(model, q, *, ws=None, out=None):
     q = _vector('q', q, ws.n)
     _check_finite(q, ws.zeros, ws.zeros, ws.zero_wrench)
     D = np.empty((ws.n, ws.n)) if out is None else out
-    K.mass_matrix(model.links_array, model.frames_array, q, ws.ws,
-                  ws.scratch, D)
-    return _finite_result(D)
+    if K.mass_matrix(model.links_array, model.frames_array, q, ws.ws,
+                     ws.scratch, D) >= 0:
+        _raise_nonfinite(K.OVERFLOW, ())
+    return D
 
 
 def mass_matrix_condition(model, q, *, ws=None):
@@ -286,9 +287,10 @@ def coriolis_matrix(model, q, qd, *, ws=None, out=None):
     qd = _vector('qd', qd, ws.n)
     _check_finite(q, qd, ws.zeros, ws.zero_wrench)
     C = np.empty((ws.n, ws.n)) if out is None else out
-    K.coriolis_matrix(model.links_array, model.frames_array, q, qd, ws.ws,
-                      ws.scratch, C)
-    return _finite_result(C)
+    if K.coriolis_matrix(model.links_array, model.frames_array, q, qd,
+                         ws.ws, ws.scratch, C) >= 0:
+        _raise_nonfinite(K.OVERFLOW, ())
+    return C
 
 
 def velocity_products(model, q, qd, *, ws=None, out=None):
