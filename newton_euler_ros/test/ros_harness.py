@@ -84,3 +84,15 @@ class Probe:
         self.executor.shutdown()
         self.node.destroy_node()
         self.rclpy.try_shutdown(context=self.context)
+
+    def next_counters(self, diagnostics, timeout=5.0):
+        """
+        Return the node's input counters from the next diagnostics message.
+
+        ``diagnostics`` is the list a ``collect(DiagnosticArray, ...)``
+        fills.
+        """
+        count = len(diagnostics)
+        assert self.spin_until(lambda: len(diagnostics) > count, timeout)
+        return {kv.key: int(kv.value)
+                for kv in diagnostics[-1].status[0].values}

@@ -210,9 +210,7 @@ class Graph:
         self.sent['wrenches'] += 1
 
     def counters(self):
-        count = len(self.diag)
-        assert self.probe.spin_until(lambda: len(self.diag) > count, 5.0)
-        return {kv.key: int(kv.value) for kv in self.diag[-1].status[0].values}
+        return self.probe.next_counters(self.diag)
 
 
 @pytest.fixture(scope='module')
