@@ -77,7 +77,6 @@ class Workspace:
         self.chol = np.zeros((n, n))
         self.zeros = np.zeros(n)
         self.zero_wrench = np.zeros(6)
-        self.vec = np.zeros(n)
 
 
 _workspaces = weakref.WeakKeyDictionary()
@@ -382,8 +381,8 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
     ws = ws or _default_ws(model)
     n = ws.n
     tau = _vector('tau', tau, n)
-    if K.first_nonfinite(tau) >= 0:
-        i = K.first_nonfinite(tau)
+    i = K.first_nonfinite(tau)
+    if i >= 0:
         raise DynamicsInputError(
             f'tau[{i}] is {float(tau[i])!r}; every entry must be finite')
     bias = inverse_dynamics(model, q, qd, None, wrench, wrench_frame,
