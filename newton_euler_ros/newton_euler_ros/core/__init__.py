@@ -16,7 +16,8 @@
 Pure numpy/numba core: robot model, kinematics and dynamics (no ROS).
 
 See :mod:`newton_euler_ros.core.dynamics` for the functions, one per term
-of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``.
+of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``, and
+:mod:`newton_euler_ros.core.float32` for the same in single precision.
 """
 from .dynamics import (coriolis_matrix, end_effector_pose, forward_dynamics,
                        gravity_torques, inverse_dynamics,
@@ -25,12 +26,13 @@ from .dynamics import (coriolis_matrix, end_effector_pose, forward_dynamics,
                        velocity_products, Workspace, wrench_torques)
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
+from .float32 import Float32Dynamics
 from .model import make_model, pose_matrix, RobotModel, rpy_matrix
 from .robot_file import (bundled_robots, inspect_robot, load_robot,
                          robot_from_dict, RobotFileWarning)
 
 __all__ = [
-    'DynamicsInputError', 'NewtonEulerError', 'NotPositiveDefiniteError',
+    'DynamicsInputError', 'Float32Dynamics', 'NewtonEulerError', 'NotPositiveDefiniteError',
     'RobotFileError', 'RobotFileWarning', 'RobotModel', 'Workspace',
     'bundled_robots', 'coriolis_matrix', 'end_effector_pose',
     'forward_dynamics', 'gravity_torques', 'inspect_robot',

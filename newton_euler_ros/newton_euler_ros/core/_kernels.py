@@ -21,6 +21,14 @@ Python on other number types (the high-precision reference evaluates this
 file with ``njit`` replaced by the identity).  Nothing here allocates in
 the hot path: callers pass a workspace array.
 
+Number types.  The kernels are generic in the dtype of the arrays they
+are given: they contain no float literal (numba types one as float64, and
+float32 op float64 is float64), taking 0, 1/2 and 1 from the constants
+row ``frames[F_CONST]`` instead, and comparing with integer literals only.
+So float64 arrays give float64 arithmetic, float32 arrays give float32
+arithmetic throughout (``core.float32``; the tests check numba's type
+maps), and mpf object arrays give mpmath arithmetic (``core.highprec``).
+
 Notation (all vectors of link j are expressed in link frame j):
 
 - ``R``, ``p``: rotation and origin of link frame j in frame j-1.
@@ -73,10 +81,21 @@ L_CT0 = 20       # cos(theta offset)
 L_ST0 = 21       # sin(theta offset)
 L_WIDTH = 22
 
-# Rows of the fixed-frame array ``frames`` (shape (3, 12)).
+# Rows of the fixed-frame array ``frames`` (shape (F_ROWS, 12)).
 F_BASE = 0       # R (9, row-major) then p (3): DH frame 0 in the base frame
 F_TOOL = 1       # end-effector frame in the last link frame
 F_GRAV = 2       # first 3 entries: gravity in frame-0 axes
+F_CONST = 3      # the constants below, in the arrays' own number type
+F_ROWS = 4
+
+# Columns of the constants row ``frames[F_CONST]``.  A float literal in
+# numba code is a float64, and float32 op float64 is float64: the kernels
+# take every constant from this row so that they compute purely in the
+# dtype of the arrays they are given (float64, float32, or mpmath's mpf).
+C_ZERO = 0       # 0.0
+C_HALF = 1       # 0.5
+C_ONE = 2        # 1.0
+CONSTANTS = (0.0, 0.5, 1.0)
 
 # Columns of the workspace ``ws`` (one row per joint).
 W_R = 0          # 9
@@ -105,7 +124,13 @@ def _cross(a0, a1, a2, b0, b1, b2):
 
 
 @njit(cache=True)
-def joint_trig(links, q, ws):
+def _revolute(links, frames, j):
+    """Return True when joint j is revolute (its type code is zero)."""
+    return links[j, L_TYPE] == frames[F_CONST, C_ZERO]
+
+
+@njit(cache=True)
+def joint_trig(links, frames, q, ws):
     """
     Fill cos(theta_j), sin(theta_j), d_j of every joint into ``ws``.
 
@@ -118,7 +143,7 @@ def joint_trig(links, q, ws):
     for j in range(n):
         ct0 = links[j, L_CT0]
         st0 = links[j, L_ST0]
-        if links[j, L_TYPE] == 0.0:
+        if _revolute(links, frames, j):
             cq = math.cos(q[j])
             sq = math.sin(q[j])
             ws[j, W_CT] = cq * ct0 - sq * st0
@@ -131,7 +156,7 @@ def joint_trig(links, q, ws):
 
 
 @njit(cache=True)
-def _link_geometry(links, j, ws):
+def _link_geometry(links, frames, j, ws):
     """R, p, u, s and rK of joint j from the trig values in ``ws``."""
     ct = ws[j, W_CT]
     st = ws[j, W_ST]
@@ -139,8 +164,8 @@ def _link_geometry(links, j, ws):
     a = links[j, L_A]
     ca = links[j, L_CA]
     sa = links[j, L_SA]
-    zero = 0.0 * ct
-    if links[j, L_CONV] == 0.0:
+    zero = frames[F_CONST, C_ZERO]
+    if links[j, L_CONV] == zero:
         # standard: A = Rz(theta) Tz(d) Tx(a) Rx(alpha); axis z_{j-1} through
         # K = O_{j-1} + d z_{j-1}; O_j = K + a x_j.
         R = (ct, -st * ca, st * sa, st, ct * ca, -ct * sa, zero, sa, ca)
@@ -153,7 +178,7 @@ def _link_geometry(links, j, ws):
         # through K = O_j.
         R = (ct, -st, zero, ca * st, ca * ct, -sa, sa * st, sa * ct, ca)
         p = (a, -sa * d, ca * d)
-        u = (zero, zero, 1.0 + zero)
+        u = (zero, zero, frames[F_CONST, C_ONE])
         s = (zero, zero, zero)
         rK = p
     return R, p, u, s, rK
@@ -200,7 +225,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
     """
     Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
 
-    ``joint_trig(links, q, ws)`` must have been called for the same q.
+    ``joint_trig(links, frames, q, ws)`` must have been called for the same q.
     Cost: about 330 flops per joint, O(n).
 
     Parameters
@@ -208,8 +233,8 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
     links : (n, L_WIDTH) array
         Per-joint DH, mass, centre-of-mass and inertia parameters (the
         ``L_*`` columns).
-    frames : (3, 12) array
-        Base frame, tool frame and gravity (the ``F_*`` rows).
+    frames : (F_ROWS, 12) array
+        Base frame, tool frame, gravity and constants (the ``F_*`` rows).
     qd, v, qdd : (n,) arrays
         Joint velocity, reference velocity, acceleration.
     wrench : (6,) array
@@ -229,7 +254,8 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
 
     """
     n = links.shape[0]
-    zero = 0.0 * ws[0, W_CT]
+    zero = frames[F_CONST, C_ZERO]
+    half = frames[F_CONST, C_HALF]
     # Gravity enters as an upward acceleration of the base: a_0 = -g.
     if gravity_on:
         ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
@@ -242,7 +268,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
 
     # ---- forward recursion: base to tip ----
     for j in range(n):
-        R, p, u, s, rK = _link_geometry(links, j, ws)
+        R, p, u, s, rK = _link_geometry(links, frames, j, ws)
         # acceleration of the point K, still in frame j-1 axes
         t = _cross(al[0], al[1], al[2], rK[0], rK[1], rK[2])
         aK = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
@@ -253,7 +279,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         # rotate everything into frame j
         aK = _rotT(R, aK[0], aK[1], aK[2])
         al = _rotT(R, al[0], al[1], al[2])
-        revolute = links[j, L_TYPE] == 0.0
+        revolute = _revolute(links, frames, j)
         if velocity_on:
             w = _rotT(R, w[0], w[1], w[2])
             r = _rotT(R, r[0], r[1], r[2])
@@ -315,9 +341,9 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
             t2 = _cross(r[0], r[1], r[2], Iw[0], Iw[1], Iw[2])
             wr = _cross(w[0], w[1], w[2], r[0], r[1], r[2])
             t3 = _rot(Ic, wr[0], wr[1], wr[2])
-            Nn = (Ia[0] + 0.5 * ((t[0] + t2[0]) + t3[0]),
-                  Ia[1] + 0.5 * ((t[1] + t2[1]) + t3[1]),
-                  Ia[2] + 0.5 * ((t[2] + t2[2]) + t3[2]))
+            Nn = (Ia[0] + half * ((t[0] + t2[0]) + t3[0]),
+                  Ia[1] + half * ((t[1] + t2[1]) + t3[1]),
+                  Ia[2] + half * ((t[2] + t2[2]) + t3[2]))
         ws[j, W_N] = Nn[0]
         ws[j, W_N + 1] = Nn[1]
         ws[j, W_N + 2] = Nn[2]
@@ -362,7 +388,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         u0 = ws[j, W_U]
         u1 = ws[j, W_U + 1]
         u2 = ws[j, W_U + 2]
-        if links[j, L_TYPE] == 0.0:
+        if _revolute(links, frames, j):
             # moment about the axis point K = O_j - s
             t = _cross(ws[j, W_S], ws[j, W_S + 1], ws[j, W_S + 2],
                        f[0], f[1], f[2])
@@ -388,6 +414,18 @@ def first_nonfinite(x):
         if not math.isfinite(x[i]):
             return i
     return -1
+
+
+@njit(cache=True)
+def round_into(x, out):
+    """
+    Copy x into out, converting to out's dtype.
+
+    float64 -> float32 rounds to nearest and gives +-inf past the float32
+    range, without the warning numpy's cast would print.
+    """
+    for i in range(x.shape[0]):
+        out[i] = x[i]
 
 
 @njit(cache=True)
@@ -420,7 +458,7 @@ def inverse_dynamics(links, frames, q, qd, qdd, wrench, gravity_on,
     bad = check_finite(q, qd, qdd, wrench)
     if bad >= 0:
         return bad
-    joint_trig(links, q, ws)
+    joint_trig(links, frames, q, ws)
     recursion(links, frames, qd, qd, qdd, wrench, gravity_on, velocity_on,
               wrench_mode, ws, tau)
     if first_nonfinite(tau) >= 0:
@@ -433,7 +471,7 @@ def inverse_dynamics_batch(links, frames, Q, QD, QDD, W, gravity_on,
                            velocity_on, wrench_mode, ws, TAU):
     """Row-by-row inverse dynamics over a batch of states."""
     for k in range(Q.shape[0]):
-        joint_trig(links, Q[k], ws)
+        joint_trig(links, frames, Q[k], ws)
         recursion(links, frames, QD[k], QD[k], QDD[k], W[k], gravity_on,
                   velocity_on, wrench_mode, ws, TAU[k])
 
@@ -452,17 +490,17 @@ def _unit_columns(links, frames, qd, coriolis, ws, scratch, M):
     unit = scratch[1]
     col = scratch[2]
     for i in range(n):
-        zero[i] = 0.0
-        unit[i] = 0.0
+        zero[i] = frames[F_CONST, C_ZERO]
+        unit[i] = frames[F_CONST, C_ZERO]
     for k in range(n):
-        unit[k] = 1.0
+        unit[k] = frames[F_CONST, C_ONE]
         if coriolis:
             recursion(links, frames, qd, unit, zero, zero, False, True,
                       WRENCH_NONE, ws, col)
         else:
             recursion(links, frames, zero, zero, unit, zero, False, False,
                       WRENCH_NONE, ws, col)
-        unit[k] = 0.0
+        unit[k] = frames[F_CONST, C_ZERO]
         for i in range(n):
             M[i, k] = col[i]
 
@@ -471,12 +509,13 @@ def _unit_columns(links, frames, qd, coriolis, ws, scratch, M):
 def mass_matrix(links, frames, q, ws, scratch, D):
     """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k)."""
     n = links.shape[0]
-    joint_trig(links, q, ws)
+    half = frames[F_CONST, C_HALF]
+    joint_trig(links, frames, q, ws)
     _unit_columns(links, frames, q, False, ws, scratch, D)
     # D is symmetric in exact arithmetic; make it so to the last bit.
     for i in range(n):
         for k in range(i + 1, n):
-            avg = 0.5 * (D[i, k] + D[k, i])
+            avg = half * (D[i, k] + D[k, i])
             D[i, k] = avg
             D[k, i] = avg
     return _matrix_status(D)
@@ -485,9 +524,174 @@ def mass_matrix(links, frames, q, ws, scratch, D):
 @njit(cache=True)
 def coriolis_matrix(links, frames, q, qd, ws, scratch, C):
     """Christoffel C(q, qd) column by column: C e_k = Y(q, qd, e_k, 0)."""
-    joint_trig(links, q, ws)
+    joint_trig(links, frames, q, ws)
     _unit_columns(links, frames, qd, True, ws, scratch, C)
     return _matrix_status(C)
+
+
+@njit(cache=True)
+def _sym_mul(S, x0, x1, x2):
+    """S x for a symmetric S stored as (xx, yy, zz, xy, yz, xz)."""
+    return (S[0] * x0 + S[3] * x1 + S[5] * x2,
+            S[3] * x0 + S[1] * x1 + S[4] * x2,
+            S[5] * x0 + S[4] * x1 + S[2] * x2)
+
+
+@njit(cache=True)
+def _sym_rotate(R, S):
+    """R S R^T for a symmetric S, both stored as (xx, yy, zz, xy, yz, xz)."""
+    # rows of A = R S (S is symmetric, so row k of R times S is S r_k)
+    a0 = _sym_mul(S, R[0], R[1], R[2])
+    a1 = _sym_mul(S, R[3], R[4], R[5])
+    a2 = _sym_mul(S, R[6], R[7], R[8])
+    # (A R^T)_ik = a_i . r_k, upper triangle only
+    return (a0[0] * R[0] + a0[1] * R[1] + a0[2] * R[2],
+            a1[0] * R[3] + a1[1] * R[4] + a1[2] * R[5],
+            a2[0] * R[6] + a2[1] * R[7] + a2[2] * R[8],
+            a0[0] * R[3] + a0[1] * R[4] + a0[2] * R[5],
+            a1[0] * R[6] + a1[1] * R[7] + a1[2] * R[8],
+            a0[0] * R[6] + a0[1] * R[7] + a0[2] * R[8])
+
+
+@njit(cache=True)
+def _joint_force(links, frames, j, ws, F0, F1, F2, N0, N1, N2):
+    """
+    Joint j's component of the wrench (F, N about O_j) in frame j.
+
+    The moment about the axis for a revolute joint, u . (N + s x F), the
+    force along it for a prismatic one, u . F (the recursion's last step).
+    """
+    u0 = ws[j, W_U]
+    u1 = ws[j, W_U + 1]
+    u2 = ws[j, W_U + 2]
+    if _revolute(links, frames, j):
+        t = _cross(ws[j, W_S], ws[j, W_S + 1], ws[j, W_S + 2], F0, F1, F2)
+        return u0 * (N0 + t[0]) + u1 * (N1 + t[1]) + u2 * (N2 + t[2])
+    return u0 * F0 + u1 * F1 + u2 * F2
+
+
+@njit(cache=True)
+def mass_matrix_crba(links, frames, q, ws, D):
+    """
+    D(q) by the composite-rigid-body algorithm (CRBA); O(n^2), small constant.
+
+    Column i of D is the torque for qdd = e_i at rest without gravity
+    (what ``mass_matrix`` computes with one recursion).  Then links 0..i-1
+    stand still and need no force, and links i..n-1 move as one rigid
+    *composite body i*; so every joint j <= i transmits just the wrench
+    composite i needs, and D[j, i] is joint j's component of it.  The
+    entries j > i of the column come from symmetry, D[j, i] = D[i, j],
+    filled when column j is done.
+
+    Composite i is kept in frame i as its mass M, first moment
+    h = sum m_k c_k (c_k: centre of mass of link k seen from O_i) and
+    rotational inertia I about O_i, never divided by the mass, so massless
+    links and composites need no care.  It is built from the tip: add link
+    i (h += m c, I += I_c + m (|c|^2 1 - c c^T), with the symmetric part of
+    I_c), use it, then carry it into frame i-1 (R, p of frame i in frame
+    i-1): with hr = R h, h' = hr + M p and, since the position of each
+    mass element becomes r' = R r + p,
+    I' = R I R^T - [p][hr] - [hr][p] - M [p][p] ([x] the cross-product
+    matrix), written with g = hr + M p / 2 as
+    I' = R I R^T + 2 (g . p) 1 - (g p^T + p g^T) so it stays symmetric.
+
+    Unit rate of joint i: revolute, angular acceleration al = u about the
+    axis through K, so O_i accelerates by a = u x s; prismatic, al = 0
+    and a = u.  Newton-Euler about O_i (not the centre of mass) at zero
+    velocity: F = M a + al x h, N = I al + h x a.  D[i, i] is joint i's
+    component (``_joint_force``: u . (N + s x F), or u . F); for
+    j = i-1..0 the wrench is carried to frame j by the recursion's
+    backward step F <- R F, N <- R N + p x F and D[j, i] = D[i, j] is joint
+    j's component.  D is symmetric exactly.  Cost: about 200 flops per
+    joint plus 60 per pair j < i, against the n recursions of
+    ``mass_matrix``; the same D as those up to round-off (the tests check
+    10 n eps in float64 and 1e-40 at 50 digits).
+
+    Returns -1, or OVERFLOW when an entry is not finite (as ``mass_matrix``).
+    """
+    n = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    half = frames[F_CONST, C_HALF]
+    joint_trig(links, frames, q, ws)
+    for j in range(n):
+        R, p, u, s, rK = _link_geometry(links, frames, j, ws)
+        for k in range(9):
+            ws[j, W_R + k] = R[k]
+        for k in range(3):
+            ws[j, W_P + k] = p[k]
+            ws[j, W_U + k] = u[k]
+            ws[j, W_S + k] = s[k]
+    M = zero
+    h = (zero, zero, zero)
+    Io = (zero, zero, zero, zero, zero, zero)
+    for i in range(n - 1, -1, -1):
+        # ---- add link i to the composite (frame i, about O_i) ----
+        m = links[i, L_MASS]
+        c0 = links[i, L_COM]
+        c1 = links[i, L_COM + 1]
+        c2 = links[i, L_COM + 2]
+        mc0 = m * c0
+        mc1 = m * c1
+        mc2 = m * c2
+        k = L_INERTIA
+        M = M + m
+        h = (h[0] + mc0, h[1] + mc1, h[2] + mc2)
+        Io = (Io[0] + links[i, k] + (mc1 * c1 + mc2 * c2),
+              Io[1] + links[i, k + 4] + (mc0 * c0 + mc2 * c2),
+              Io[2] + links[i, k + 8] + (mc0 * c0 + mc1 * c1),
+              Io[3] + half * (links[i, k + 1] + links[i, k + 3]) - mc0 * c1,
+              Io[4] + half * (links[i, k + 5] + links[i, k + 7]) - mc1 * c2,
+              Io[5] + half * (links[i, k + 2] + links[i, k + 6]) - mc0 * c2)
+        # ---- wrench on the composite for a unit rate of joint i ----
+        u = (ws[i, W_U], ws[i, W_U + 1], ws[i, W_U + 2])
+        if _revolute(links, frames, i):
+            a = _cross(u[0], u[1], u[2], ws[i, W_S], ws[i, W_S + 1],
+                       ws[i, W_S + 2])
+            t = _cross(u[0], u[1], u[2], h[0], h[1], h[2])
+            F = (M * a[0] + t[0], M * a[1] + t[1], M * a[2] + t[2])
+            Iu = _sym_mul(Io, u[0], u[1], u[2])
+            t = _cross(h[0], h[1], h[2], a[0], a[1], a[2])
+            N = (Iu[0] + t[0], Iu[1] + t[1], Iu[2] + t[2])
+        else:
+            F = (M * u[0], M * u[1], M * u[2])
+            N = _cross(h[0], h[1], h[2], u[0], u[1], u[2])
+        D[i, i] = _joint_force(links, frames, i, ws, F[0], F[1], F[2],
+                               N[0], N[1], N[2])
+        # ---- carry it to the base, joint by joint ----
+        for j in range(i - 1, -1, -1):
+            R = (ws[j + 1, W_R], ws[j + 1, W_R + 1], ws[j + 1, W_R + 2],
+                 ws[j + 1, W_R + 3], ws[j + 1, W_R + 4], ws[j + 1, W_R + 5],
+                 ws[j + 1, W_R + 6], ws[j + 1, W_R + 7], ws[j + 1, W_R + 8])
+            F = _rot(R, F[0], F[1], F[2])
+            N = _rot(R, N[0], N[1], N[2])
+            t = _cross(ws[j + 1, W_P], ws[j + 1, W_P + 1], ws[j + 1, W_P + 2],
+                       F[0], F[1], F[2])
+            N = (N[0] + t[0], N[1] + t[1], N[2] + t[2])
+            x = _joint_force(links, frames, j, ws, F[0], F[1], F[2],
+                             N[0], N[1], N[2])
+            D[j, i] = x
+            D[i, j] = x
+        # ---- the composite in frame i-1, about O_{i-1} ----
+        if i > 0:
+            R = (ws[i, W_R], ws[i, W_R + 1], ws[i, W_R + 2],
+                 ws[i, W_R + 3], ws[i, W_R + 4], ws[i, W_R + 5],
+                 ws[i, W_R + 6], ws[i, W_R + 7], ws[i, W_R + 8])
+            p = (ws[i, W_P], ws[i, W_P + 1], ws[i, W_P + 2])
+            hr = _rot(R, h[0], h[1], h[2])
+            Ir = _sym_rotate(R, Io)
+            hM = half * M
+            g = (hr[0] + hM * p[0], hr[1] + hM * p[1], hr[2] + hM * p[2])
+            g0p0 = g[0] * p[0]
+            g1p1 = g[1] * p[1]
+            g2p2 = g[2] * p[2]
+            Io = (Ir[0] + ((g1p1 + g2p2) + (g1p1 + g2p2)),
+                  Ir[1] + ((g0p0 + g2p2) + (g0p0 + g2p2)),
+                  Ir[2] + ((g0p0 + g1p1) + (g0p0 + g1p1)),
+                  Ir[3] - (g[0] * p[1] + g[1] * p[0]),
+                  Ir[4] - (g[1] * p[2] + g[2] * p[1]),
+                  Ir[5] - (g[0] * p[2] + g[2] * p[0]))
+            h = (hr[0] + M * p[0], hr[1] + M * p[1], hr[2] + M * p[2])
+    return _matrix_status(D)
 
 
 @njit(cache=True)
@@ -508,7 +712,7 @@ def forward_kinematics(links, frames, q, ws, Ts):
     effector; each row R (9, row-major) then p (3).
     """
     n = links.shape[0]
-    joint_trig(links, q, ws)
+    joint_trig(links, frames, q, ws)
     Rw = _frame_rot(frames, F_BASE)
     pw = (frames[F_BASE, 9], frames[F_BASE, 10], frames[F_BASE, 11])
     for k in range(9):
@@ -517,7 +721,7 @@ def forward_kinematics(links, frames, q, ws, Ts):
         Ts[0, 9 + k] = pw[k]
     for j in range(n + 1):
         if j < n:
-            R, p, u, s, rK = _link_geometry(links, j, ws)
+            R, p, u, s, rK = _link_geometry(links, frames, j, ws)
         else:
             R = _frame_rot(frames, F_TOOL)
             p = (frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11])
@@ -540,23 +744,24 @@ def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
     n = links.shape[0]
     forward_kinematics(links, frames, q, ws, Ts)
     pe = (Ts[n + 1, 9], Ts[n + 1, 10], Ts[n + 1, 11])
+    zero = frames[F_CONST, C_ZERO]
     for j in range(n):
         # the axis of joint j and a point K on it, in base axes
-        if links[j, L_CONV] == 0.0:
+        if links[j, L_CONV] == zero:
             row = j           # standard: z_{j-1} through O_{j-1} + d z_{j-1}
         else:
             row = j + 1       # modified: z_j through O_j
         Rr = (Ts[row, 0], Ts[row, 1], Ts[row, 2], Ts[row, 3], Ts[row, 4],
               Ts[row, 5], Ts[row, 6], Ts[row, 7], Ts[row, 8])
         z = (Rr[2], Rr[5], Rr[8])
-        if links[j, L_TYPE] == 0.0:
+        if _revolute(links, frames, j):
             rel = (pe[0] - Ts[row, 9], pe[1] - Ts[row, 10],
                    pe[2] - Ts[row, 11])
             lin = _cross(z[0], z[1], z[2], rel[0], rel[1], rel[2])
             ang = z
         else:
             lin = z
-            ang = (0.0, 0.0, 0.0)
+            ang = (zero, zero, zero)
         if in_ee_axes:
             Re = (Ts[n + 1, 0], Ts[n + 1, 1], Ts[n + 1, 2], Ts[n + 1, 3],
                   Ts[n + 1, 4], Ts[n + 1, 5], Ts[n + 1, 6], Ts[n + 1, 7],
@@ -583,7 +788,7 @@ def cholesky_solve(A, b, L, x):
             for m in range(k):
                 acc -= L[i, m] * L[k, m]
             if i == k:
-                if not acc > 0.0:
+                if not acc > 0:     # an int literal: exact in any dtype
                     return i
                 L[i, i] = math.sqrt(acc)
             else:

@@ -33,6 +33,7 @@ import mpmath
 import numpy as np
 
 from . import _kernels as K
+from .dynamics import _bad_method, MASS_MATRIX_METHODS
 
 _SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        '_kernels.py')
@@ -110,21 +111,31 @@ class HighPrecisionModel:
             tau = np.empty(n, dtype=object)
             qv = self._vec(q, n)
             qdv = self._vec(qd, n)
-            _MP.joint_trig(self.links, qv, ws)
+            _MP.joint_trig(self.links, self.frames, qv, ws)
             _MP.recursion(self.links, self.frames, qdv, qdv,
                           self._vec(qdd, n), self._vec(wrench, 6), gravity,
                           velocity_products, mode, ws, tau)
         return tau
 
-    def mass_matrix(self, q):
-        """Return D(q) as an (n, n) object array of mpf."""
+    def mass_matrix(self, q, method='newton_euler'):
+        """
+        Return D(q) as an (n, n) object array of mpf.
+
+        ``method`` as in :func:`~newton_euler_ros.core.dynamics.mass_matrix`:
+        ``'newton_euler'`` (n recursions, not symmetrized) or ``'crba'``.
+        """
         n = self.model.n
+        if method not in MASS_MATRIX_METHODS:
+            raise _bad_method(method)
         with mpmath.workdps(self.dps):
             ws = np.empty((n, K.W_WIDTH), dtype=object)
             scratch = np.empty((3, n), dtype=object)
             D = np.empty((n, n), dtype=object)
             qv = self._vec(q, n)
-            _MP.joint_trig(self.links, qv, ws)
+            if method == 'crba':
+                _MP.mass_matrix_crba(self.links, self.frames, qv, ws, D)
+                return D
+            _MP.joint_trig(self.links, self.frames, qv, ws)
             zero = mpmath.mpf(0)
             for i in range(3):
                 for k in range(n):
@@ -140,7 +151,7 @@ class HighPrecisionModel:
             ws = np.empty((n, K.W_WIDTH), dtype=object)
             scratch = np.empty((3, n), dtype=object)
             C = np.empty((n, n), dtype=object)
-            _MP.joint_trig(self.links, self._vec(q, n), ws)
+            _MP.joint_trig(self.links, self.frames, self._vec(q, n), ws)
             zero = mpmath.mpf(0)
             for i in range(3):
                 for k in range(n):

@@ -128,7 +128,8 @@ class RobotModel:
             links[j, K.L_MASS] = self.mass[j]
             links[j, K.L_COM:K.L_COM + 3] = self.com[j]
             links[j, K.L_INERTIA:K.L_INERTIA + 9] = self.inertia[j].ravel()
-        frames = np.zeros((3, 12))
+        frames = np.zeros((K.F_ROWS, 12))
+        frames[K.F_CONST, :len(K.CONSTANTS)] = K.CONSTANTS
         for row, T in ((K.F_BASE, self.base), (K.F_TOOL, self.tool)):
             frames[row, :9] = T[:3, :3].ravel()
             frames[row, 9:] = T[:3, 3]
