@@ -138,21 +138,40 @@ class SceneDynamics:
         return p_tau, p_f, p_w
 
 
-def tracking_controller(dyn, feedforward=None):
+FEEDFORWARD_AT = ('desired', 'measured')
+
+
+def check_feedforward_at(value):
+    """Return ``value`` if it is 'desired' or 'measured'; else raise."""
+    if not isinstance(value, str) or value not in FEEDFORWARD_AT:
+        raise ValueError(f"feedforward_at must be 'desired' or 'measured', "
+                         f'got {value!r}')
+    return value
+
+
+def tracking_controller(dyn, feedforward=None, feedforward_at='desired'):
     """
     PD on the scene's reference, plus feedforward torques.
 
     ``feedforward`` defaults to the scene's setting.  The feedforward is
-    the scene's inverse dynamics at the desired state.
+    the scene's inverse dynamics at the desired state (q_d, qd_d, qdd_d)
+    with ``feedforward_at='desired'``, or at the measured state
+    (q, qd, qdd_d) with ``'measured'``: the reference acceleration with
+    the measured positions and velocities.
     """
     scene = dyn.scene
     use_ff = scene.feedforward if feedforward is None else feedforward
+    measured = check_feedforward_at(feedforward_at) == 'measured'
 
     def control(t, q, qd):
         q_d, qd_d, qdd_d = scene.reference.at(t)
         tau = scene.kp * (q_d - q) + scene.kd * (qd_d - qd)
-        ff = dyn.torques(q_d, qd_d, qdd_d, t) if use_ff else \
-            np.zeros_like(q)
+        if not use_ff:
+            ff = np.zeros_like(q)
+        elif measured:
+            ff = dyn.torques(q, qd, qdd_d, t)
+        else:
+            ff = dyn.torques(q_d, qd_d, qdd_d, t)
         return tau + ff, ff
     return control
 
@@ -182,16 +201,21 @@ class SimulationResult:
 
 
 def simulate(scene, duration=None, controller=None, feedforward=None,
-             integrator=None, step=None, progress=False):
+             integrator=None, step=None, progress=False,
+             feedforward_at='desired'):
     """
     Simulate a scene deterministically; return a SimulationResult.
 
     ``controller(t, q, qd) -> (tau, tau_ff)`` defaults to
-    :func:`tracking_controller`; torques are held constant over each step
-    (as a digital controller would).  ``progress`` shows a progress bar.
+    :func:`tracking_controller` (with ``feedforward`` and
+    ``feedforward_at``, 'desired' or 'measured'); torques are held
+    constant over each step (as a digital controller would).
+    ``progress`` shows a progress bar.
     """
+    check_feedforward_at(feedforward_at)
     dyn = SceneDynamics(scene)
-    control = controller or tracking_controller(dyn, feedforward)
+    control = controller or tracking_controller(dyn, feedforward,
+                                                feedforward_at)
     method = integrator or scene.integrator
     dt = step or scene.step
     T = scene.duration if duration is None else duration
