@@ -251,7 +251,7 @@ def _dispatch_probes():
         return -1
 
     @njit(cache=False)
-    def noop_mm(links, frames, q, ws, scratch, D):
+    def noop_mm(links, frames, q, ws, D):
         return None
 
     @njit(cache=False)
@@ -385,7 +385,7 @@ def bench_robot(name, timer, rng, log):
     raw = {
         'tau': 'K.inverse_dynamics(links, frames, q, qd, qdd, zero_w, True, '
                'True, WN, wsa, tau)',
-        'D': 'K.mass_matrix(links, frames, q, wsa, scratch, D)',
+        'D': 'K.mass_matrix_crba(links, frames, q, wsa, D)',
         'C': 'K.coriolis_matrix(links, frames, q, qd, wsa, scratch, C)',
         'g': 'K.inverse_dynamics(links, frames, q, zeros, zeros, zero_w, '
              'True, False, WN, wsa, g)',
@@ -438,7 +438,7 @@ def bench_robot(name, timer, rng, log):
         'njit_1_array': 'noop1(q)',
         'njit_id_args': 'noop_id(links, frames, q, qd, qdd, zero_w, True, '
                         'True, WN, wsa, tau)',
-        'njit_D_args': 'noop_mm(links, frames, q, wsa, scratch, D)',
+        'njit_D_args': 'noop_mm(links, frames, q, wsa, D)',
         'njit_C_args': 'noop_cm(links, frames, q, qd, wsa, scratch, C)',
         'check_finite_kernel': 'K.check_finite(q, qd, qdd, zero_w)',
         '_vector_one_arg': "_vector('q', q, n)",

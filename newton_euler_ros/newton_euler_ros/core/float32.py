@@ -187,12 +187,12 @@ class Float32Dynamics:
             _raise(bad, (q32, qd32, qdd32, w32), (q, qd, qdd, wrench))
         return tau
 
-    def mass_matrix(self, q, *, method='newton_euler', out=None):
+    def mass_matrix(self, q, *, method='crba', out=None):
         """
         Joint-space inertia matrix D(q), (n, n) float32.
 
-        ``method`` is ``'newton_euler'`` (n recursions) or ``'crba'``
-        (composite-rigid-body algorithm), as in
+        ``method`` is ``'crba'`` (composite-rigid-body algorithm, the
+        default) or ``'newton_euler'`` (n recursions), as in
         :func:`~newton_euler_ros.core.dynamics.mass_matrix`.
         """
         n = self.n
