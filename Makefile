@@ -4,6 +4,8 @@
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
+#   make accuracy  accuracy-vs-time report -> docs/accuracy-vs-time.md (+ peers)
+#   make accuracy-quick  the same in under a minute, into build/accuracy-quick
 #   make colcon-check  build both packages as a ROS 2 workspace with colcon
 #   make clean   remove build/, .venv and the stamps in it
 # Extra pytest arguments: make test PYTEST_ARGS='-k rnea -x'
@@ -23,7 +25,8 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
 
-.PHONY: setup test demo bench latency peers colcon-check clean
+.PHONY: setup test demo bench latency peers accuracy accuracy-quick \
+	colcon-check clean
 
 setup:
 	@bash scripts/setup_env.sh
@@ -40,6 +43,13 @@ bench: setup
 
 latency: setup
 	$(PY) -m newton_euler_ros.latency_bench
+
+# The full report compares with the peers, so it installs them first.
+accuracy: peers
+	$(PY) -m newton_euler_ros.accuracy --out docs
+
+accuracy-quick: setup
+	$(PY) -m newton_euler_ros.accuracy --quick --out build/accuracy-quick
 
 # Constrained by the main lock so the peers cannot move numpy & co.
 peers: setup

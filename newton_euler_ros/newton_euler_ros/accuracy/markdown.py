@@ -1,0 +1,277 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Write ``accuracy-vs-time.md``: tables, plots and findings from the records.
+
+Every number in the report is formatted from the records of the run that
+writes it; the sentences under "Findings" are computed the same way, so
+regenerating the report can never leave a stale figure behind.
+"""
+import os
+
+from . import plots
+from .arithmetic import EPS
+from .report import (ARITH_HEADER, arithmetic_rows, find, fmt_err, fmt_us,
+                     md_table, save_records, scaling_header, scaling_rows,
+                     scene_tables)
+
+HEADLINE_ROBOT = 'puma560'
+
+
+def _robots(records):
+    return list(dict.fromkeys(r['robot'] for r in records
+                              if r['section'] == 'arithmetic'))
+
+
+def _span(values, fmt):
+    values = [v for v in values if v is not None]
+    if not values:
+        return '-'
+    lo, hi = min(values), max(values)
+    return fmt(lo) if fmt(lo) == fmt(hi) else f'{fmt(lo)} to {fmt(hi)}'
+
+
+def _ratio(records, robot, quantity, method, base):
+    a = find(records, section='arithmetic', robot=robot, quantity=quantity,
+             method=method)
+    b = find(records, section='arithmetic', robot=robot, quantity=quantity,
+             method=base)
+    if a is None or b is None:
+        return None, None, None
+    return a['us'] / b['us'], a, b
+
+
+def findings(records, context):
+    """Return the findings as markdown bullet lines, computed from records."""
+    robots = _robots(records)
+    out = []
+    # float32
+    t_ratio = []
+    errs32 = []
+    errs64 = []
+    for robot in robots:
+        for q in ('tau', 'D', 'C', 'g'):
+            base = 'float64' if q in ('tau', 'g') else (
+                'float64, CRBA' if q == 'D' else 'float64, exact')
+            m32 = base.replace('float64', 'float32')
+            ratio, a, b = _ratio(records, robot, q, m32, base)
+            if ratio is not None:
+                t_ratio.append(ratio)
+                errs32.append(a['error'])
+                errs64.append(b['error'])
+    if t_ratio:
+        typical = sorted(t_ratio)[len(t_ratio) // 2]
+        verdict = ('float32 buys no time' if typical > 0.9 else
+                   f'float32 saves {100 * (1 - typical):.0f}% of the time')
+        out.append(
+            f'- **{verdict}.** Over every robot and quantity the float32 '
+            f'path takes {_span(t_ratio, lambda x: f"{x:.2f}x")} the float64 '
+            f'time (median {typical:.2f}x; this is scalar code, where one '
+            f'float32 operation costs what one float64 operation costs), '
+            f'while its error is {_span(errs32, fmt_err)} against '
+            f'{_span(errs64, fmt_err)} in float64.')
+    # CRBA
+    t_ratio = []
+    e_crba = []
+    e_ne = []
+    for robot in robots:
+        ratio, a, b = _ratio(records, robot, 'D', 'float64, CRBA',
+                             'float64, n recursions')
+        if ratio is not None:
+            t_ratio.append((ratio, robot, a['dof']))
+            e_crba.append(a['error'])
+            e_ne.append(b['error'])
+    if t_ratio:
+        big = max(t_ratio, key=lambda x: x[2])
+        out.append(
+            f'- **D(q): the composite-rigid-body algorithm** takes '
+            f'{_span([x[0] for x in t_ratio], lambda x: f"{x:.2f}x")} the '
+            f'time of n Newton-Euler recursions ({big[0]:.2f}x on '
+            f'{big[1]}, {big[2]} links), at an error of '
+            f'{_span(e_crba, fmt_err)} against {_span(e_ne, fmt_err)}.')
+    # finite differences
+    t_ratio = []
+    e_fd = []
+    e_ex = []
+    for robot in robots:
+        ratio, a, b = _ratio(records, robot, 'C', 'central differences of D',
+                             'float64, exact')
+        if ratio is not None:
+            t_ratio.append(ratio)
+            e_fd.append(a['error'])
+            e_ex.append(b['error'])
+    if t_ratio:
+        out.append(
+            f'- **C(q, qd) by finite differences of D** costs '
+            f'{_span(t_ratio, lambda x: f"{x:.0f}x")} the exact recursion '
+            f'and loses digits: error {_span(e_fd, fmt_err)} (central '
+            f'differences at the optimal step) against '
+            f'{_span(e_ex, fmt_err)} exact.')
+    # peers
+    lines = []
+    for q, ours, peer in (('tau', 'float64', 'Pinocchio rnea'),
+                          ('D', 'float64, CRBA', 'Pinocchio crba'),
+                          ('C', 'float64, exact',
+                           'Pinocchio computeCoriolisMatrix'),
+                          ('g', 'float64', 'Pinocchio computeGeneralizedGravity'
+                           )):
+        ratio, a, b = _ratio(records, HEADLINE_ROBOT, q, ours, peer)
+        if ratio is not None:
+            lines.append(f'{q} {ratio:.2f}x (error {fmt_err(a["error"])} vs '
+                         f'{fmt_err(b["error"])})')
+    if lines:
+        out.append(f'- **Against Pinocchio** on {HEADLINE_ROBOT}, our time '
+                   "over Pinocchio's: " + '; '.join(lines) + '.')
+    # scaling
+    exps = context.get('exponents', {})
+    if exps:
+        out.append('- **Growth with n** (fitted exponents, n >= '
+                   f'{context["fit_from"]}): ' + '; '.join(
+                       f'{op} n^{p:.2f}' for op, (p, _) in exps.items())
+                   + '.')
+    # effect subsets
+    for scene in dict.fromkeys(r['scene'] for r in records
+                               if r['section'] == 'effects'):
+        rows = [r for r in records if r['section'] == 'effects'
+                and r['scene'] == scene and r.get('error') is not None]
+        if rows:
+            out.append(f'- **{scene}**: ' + '; '.join(
+                f'{r["method"]} {fmt_us(r["us"])} us, error '
+                f'{r["error"] * 100:.3g}%' for r in rows) + '.')
+    return out
+
+
+def write_report(records, context, out_dir):
+    """Write the plots, the JSON records and the markdown; return its path."""
+    img_dir = os.path.join(out_dir, 'accuracy')
+    os.makedirs(img_dir, exist_ok=True)
+    images = {}
+    for robot in _robots(records):
+        path = os.path.join(img_dir, f'pareto-{robot}.png')
+        plots.robot_pareto(records, robot, path)
+        images[robot] = plots.relpath(path, out_dir)
+    scale = [r for r in records if r['section'] == 'scaling']
+    scaling_img = None
+    if scale:
+        path = os.path.join(img_dir, 'scaling.png')
+        plots.scaling(scale, context['exponents'], path,
+                      context['fit_from'])
+        scaling_img = plots.relpath(path, out_dir)
+    scene_imgs = {}
+    for scene in dict.fromkeys(r['scene'] for r in records
+                               if r['section'] == 'effects'):
+        path = os.path.join(img_dir, f'effects-{scene}.png')
+        plots.model_pareto(records, scene, path)
+        scene_imgs[scene] = plots.relpath(path, out_dir)
+    integ_img = None
+    path = os.path.join(img_dir, 'integrators.png')
+    if plots.integrators(records, path):
+        integ_img = plots.relpath(path, out_dir)
+    save_records(records, context, os.path.join(img_dir, 'records.json'))
+
+    md = render(records, context, images, scaling_img, scene_imgs, integ_img)
+    path = os.path.join(out_dir, 'accuracy-vs-time.md')
+    with open(path, 'w', encoding='utf-8') as fh:
+        fh.write(md)
+    return path
+
+
+def render(records, context, images, scaling_img, scene_imgs, integ_img):
+    """Return the markdown text of the report."""
+    v = context['versions']
+    lines = [
+        '# What accuracy costs in time',
+        '',
+        f'Generated by `{context["command"]}` (`make accuracy`) on '
+        f'{context["date"]}; machine: {context["machine"]}; '
+        + ', '.join(f'{k} {val}' for k, val in v.items())
+        + f'. Measurements took {context["elapsed_s"]:.0f} s.'
+        + (' **Quick mode: one state per robot and short repeats; figures '
+           'are noisy.**' if context['quick'] else ''),
+        '',
+        '## How to read this report',
+        '',
+        '- **Error** is the normwise relative error against ground truth: '
+        '`max |x - x_true| / max |x_true|` over the entries of tau, D, C '
+        'or g and over the states measured. The truth is the same '
+        'Newton-Euler recursion evaluated with mpmath at 50 significant '
+        'digits (`newton_euler_ros.core.highprec`) from the exact float64 '
+        f'inputs. float64 eps is {EPS:.3g}; "error / eps" counts it.',
+        '- **Time** is microseconds per call from Python, warm (JIT '
+        'compilation excluded): the minimum over repeats of a timed loop, '
+        'all methods of one quantity with their repeats interleaved in the '
+        'same run. "time vs float64" divides by our default float64 method.',
+        '- In the plots, lower left is better; the dashed red line is the '
+        'Pareto front (no other method is both faster and more accurate). '
+        'Exact results (error 0) sit on the bottom line.',
+        '- Peers (Pinocchio, Robotics Toolbox for Python) run models built '
+        'from ours by `newton_euler_ros.peers`; their error includes '
+        'rebuilding the DH geometry as transforms.',
+        '',
+        '## Findings',
+        '',
+        *findings(records, context),
+        '',
+    ]
+    if context['notes']:
+        lines += ['Notes: ' + ' '.join(context['notes']), '']
+    head = images.get(HEADLINE_ROBOT)
+    if head:
+        lines += [f'![{HEADLINE_ROBOT}: error against time]({head})', '']
+    lines += ['## Arithmetic and algorithms, per robot', '']
+    for robot, img in images.items():
+        rec = find(records, section='arithmetic', robot=robot)
+        lines += [f'### {robot} ({rec["dof"]} joints, {rec["states"]} '
+                  f'state(s))', '',
+                  md_table(ARITH_HEADER, arithmetic_rows(records, robot)),
+                  '']
+        notes = sorted({r['method'] + ': ' + r['note'] for r in records
+                        if r['section'] == 'arithmetic'
+                        and r['robot'] == robot and r['note']})
+        if notes:
+            lines += ['; '.join(notes) + '.', '']
+        if robot != HEADLINE_ROBOT:
+            lines += [f'![{robot}]({img})', '']
+    scale = [r for r in records if r['section'] == 'scaling']
+    if scale:
+        lines += ['## Cost growth with the number of links', '',
+                  'Random chains (`newton_euler_ros.accuracy.chains`), one '
+                  'state each; the exponent is the least-squares slope of '
+                  f'log time on log n for n >= {context["fit_from"]} (the '
+                  'three largest chains; below them the fixed cost of a '
+                  'call from Python hides the growth).', '',
+                  md_table(scaling_header(context['sizes'],
+                                          context['fit_from']),
+                           scaling_rows(scale, context['exponents'],
+                                        context['sizes'])), '']
+        if scaling_img:
+            lines += [f'![cost against n]({scaling_img})', '']
+    tables = scene_tables(records)
+    if tables:
+        lines += ['## Scenes: model fidelity, batching, feedforward, '
+                  'integrators', '']
+        for title, header, rows in tables:
+            lines += [f'### {title[0].upper()}{title[1:]}', '',
+                      md_table(header, rows), '']
+            if title.startswith('effect subsets'):
+                lines += [f'![{s}]({img})' for s, img in scene_imgs.items()]
+                lines += ['']
+            if title.startswith('integrators') and integ_img:
+                lines += [f'![integrators]({integ_img})', '']
+        notes = sorted({f'{r["section"]}: {r["note"]}' for r in records
+                        if r.get('scene') and r.get('note')})
+        if notes:
+            lines += ['Notes:', ''] + [f'- {n}' for n in notes] + ['']
+    return '\n'.join(lines)

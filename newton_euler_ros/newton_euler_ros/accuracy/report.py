@@ -1,0 +1,321 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Run every measurement; print the table; write the report and its plots.
+
+    python -m newton_euler_ros.accuracy [--quick] [--out DIR] [--no-peers]
+                                        [--robot NAME ...] [--no-scenes]
+
+Writes ``DIR/accuracy-vs-time.md`` (default ``docs/``), its PNGs under
+``DIR/accuracy/`` and every record as ``DIR/accuracy/records.json``.
+``--quick`` (one state per robot, short repeats and simulations) is a
+smoke test that finishes in under a minute; its figures are noisier.
+"""
+import argparse
+import datetime
+import json
+import os
+import platform
+import sys
+import time
+import warnings
+
+import numpy as np
+
+from .arithmetic import EPS, measure_robot
+from .chains import random_chain, random_states
+from .scaling import fit_start, FULL_SIZES, measure_scaling, QUICK_SIZES
+from .truth import GroundTruth
+from .. import peers
+from ..bench import Timer
+from ..core import load_robot
+from ..core.robot_file import bundled_robots
+
+CHAIN_SIZES = (6, 30, 100)
+QUANTITY_LABELS = {'tau': 'tau', 'D': 'D(q)', 'C': 'C(q,qd)', 'g': 'g(q)'}
+
+
+# --------------------------------------------------------------------------
+# formatting
+
+
+def fmt_us(x):
+    """Format microseconds with three significant figures."""
+    if x is None:
+        return '-'
+    if x >= 1000:
+        return f'{x:,.0f}'
+    return f'{x:.3g}'
+
+
+def fmt_err(x):
+    """Format a relative error (0 shown as 0)."""
+    if x is None:
+        return '-'
+    if x == 0:
+        return '0'
+    return f'{x:.1e}'
+
+
+def fmt_ratio(x):
+    """Format a time ratio."""
+    return '-' if x is None else f'{x:.2f}x'
+
+
+def text_table(header, rows):
+    """Return a fixed-width text table."""
+    cells = [header] + [[str(c) for c in row] for row in rows]
+    widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    lines = ['  '.join(c.ljust(w) if i == 0 or i == 1 else c.rjust(w)
+                       for i, (c, w) in enumerate(zip(r, widths)))
+             for r in cells]
+    lines.insert(1, '  '.join('-' * w for w in widths))
+    return '\n'.join(lines)
+
+
+def md_table(header, rows):
+    """Return a GitHub-flavoured markdown table."""
+    out = ['| ' + ' | '.join(header) + ' |',
+           '|' + '|'.join('---' for _ in header) + '|']
+    out += ['| ' + ' | '.join(str(c) for c in row) + ' |' for row in rows]
+    return '\n'.join(out)
+
+
+ARITH_HEADER = ['quantity', 'method', 'us/call', 'time vs float64',
+                'rel. error', 'error / eps']
+
+
+def arithmetic_rows(records, robot):
+    """Rows of the per-robot table, in measurement order."""
+    rows = []
+    for r in records:
+        if r['section'] == 'arithmetic' and r['robot'] == robot:
+            rows.append([QUANTITY_LABELS[r['quantity']], r['method'],
+                         fmt_us(r['us']), fmt_ratio(r['ratio']),
+                         fmt_err(r['error']),
+                         f'{r["error_eps"]:.3g}'])
+    return rows
+
+
+def find(records, **kw):
+    """Return the first record matching every key, or None."""
+    for r in records:
+        if all(r.get(k) == v for k, v in kw.items()):
+            return r
+    return None
+
+
+# --------------------------------------------------------------------------
+# measurements
+
+
+def robot_list(names, quick):
+    """[(model, states)] for the bundled robots and the random chains."""
+    out = []
+    per_robot = 1 if quick else 5
+    for name in names:
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            model = load_robot(name)
+        out.append((model, random_states(model, per_robot)))
+    for n in CHAIN_SIZES:
+        model = random_chain(n)
+        count = 1 if quick else {6: 5, 30: 3}.get(n, 2)
+        out.append((model, random_states(model, count)))
+    return out
+
+
+def run(args, log):
+    """Measure everything; return (records, context)."""
+    timer = Timer(args.quick)
+    notes = []
+    records = []
+    names = args.robot or bundled_robots()
+    start = time.perf_counter()
+    for model, states in robot_list(names, args.quick):
+        t0 = time.perf_counter()
+        truth = GroundTruth(model, states)
+        truth.evaluate_all()
+        t_truth = time.perf_counter() - t0
+        robot_notes = []
+        rows = measure_robot(model, truth, timer, use_peers=args.peers,
+                             notes=robot_notes)
+        for note in robot_notes:
+            if note not in notes:
+                notes.append(note)
+        records += rows
+        log(f'\n=== {model.name}: {model.n} joints, {model.convention} DH; '
+            f'{len(states)} state(s); truth in {t_truth:.1f} s ===')
+        log(text_table(ARITH_HEADER, arithmetic_rows(records, model.name)))
+
+    sizes = QUICK_SIZES if args.quick else FULL_SIZES
+    log(f'\n=== cost growth with n (random chains, n = '
+        f'{", ".join(map(str, sizes))}) ===')
+    scale_records, exponents = measure_scaling(timer, sizes,
+                                               use_peers=args.peers,
+                                               notes=notes)
+    records += scale_records
+    log(scaling_text(scale_records, exponents, sizes))
+
+    if args.scenes:
+        from . import scenes
+        log('\n=== scenes: effect subsets, batching, feedforward, '
+            'integrators ===')
+        scene_records = scenes.run_all(args.quick)
+        records += scene_records
+        for title, header, rows in scene_tables(scene_records):
+            log(f'\n--- {title} ---')
+            log(text_table(header, rows))
+    context = {'notes': notes, 'exponents': exponents, 'sizes': sizes,
+               'fit_from': fit_start(sizes),
+               'elapsed_s': time.perf_counter() - start}
+    return records, context
+
+
+# --------------------------------------------------------------------------
+# tables shared by the terminal and the markdown
+
+
+def scaling_rows(records, exponents, sizes):
+    """Rows: operation, us at each n, fitted exponent."""
+    rows = []
+    for op in dict.fromkeys(r['method'] for r in records):
+        times = {r['dof']: r['us'] for r in records if r['method'] == op}
+        p = exponents.get(op)
+        rows.append([op] + [fmt_us(times.get(n)) for n in sizes]
+                    + ['-' if p is None else f'{p[0]:.2f}'])
+    return rows
+
+
+def scaling_header(sizes, fit_from):
+    """Return the header of the scaling table."""
+    return ['operation'] + [f'n={n}' for n in sizes] + [
+        f'exponent (n>={fit_from})']
+
+
+def scaling_text(records, exponents, sizes):
+    """Return the scaling table as text."""
+    return text_table(scaling_header(sizes, fit_start(sizes)),
+                      scaling_rows(records, exponents, sizes))
+
+
+def scene_tables(records):
+    """[(title, header, rows)] for the scene sections that have records."""
+    tables = []
+    eff = [r for r in records if r['section'] == 'effects']
+    if eff:
+        tables.append((
+            'effect subsets: cost and torque error along the scene '
+            'trajectory (truth: full + wrench)',
+            ['scene', 'model', 'us/call', 'RMS error / RMS torque',
+             'max error (N m or N)'],
+            [[r['scene'], r['method'], fmt_us(r['us']), fmt_err(r['error']),
+              fmt_err(r.get('abs_error'))] for r in eff]))
+    bat = [r for r in records if r['section'] == 'batch']
+    if bat:
+        tables.append((
+            'single state vs batched over the trajectory',
+            ['scene', 'method', 'us/state', 'max |difference| (relative)'],
+            [[r['scene'], r['method'], fmt_us(r['us']), fmt_err(r['error'])]
+             for r in bat]))
+    ff = [r for r in records if r['section'] == 'feedforward']
+    if ff:
+        tables.append((
+            'feedforward at the desired vs the measured state',
+            ['scene', 'feedforward', 'us/step', 'tracking RMS (rad)',
+             'tracking max (rad)'],
+            [[r['scene'], r['method'], fmt_us(r['us']),
+              fmt_err(r.get('tracking_rms')), fmt_err(r.get('tracking_max'))]
+             for r in ff]))
+    integ = [r for r in records if r['section'] == 'integrators']
+    if integ:
+        tables.append((
+            'integrators and step sizes',
+            ['scene', 'integrator', 'step (ms)', 'us/step',
+             's per simulated s', 'max |q - converged|',
+             'energy drift (rel.)', 'tracking RMS'],
+            [[r['scene'], r['method'], f'{r["step"] * 1e3:g}',
+              fmt_us(r['us']), f'{r["cost"]:.3g}', fmt_err(r['error']),
+              fmt_err(r['drift']), fmt_err(r.get('tracking_rms'))]
+             for r in integ]))
+    return tables
+
+
+# --------------------------------------------------------------------------
+# main
+
+
+def main(argv=None):
+    """Run the report from the command line; return the exit status."""
+    parser = argparse.ArgumentParser(
+        prog='python -m newton_euler_ros.accuracy',
+        description='Measure what accuracy costs in time and write '
+                    'docs/accuracy-vs-time.md with its plots.')
+    parser.add_argument('--quick', action='store_true',
+                        help='smoke test: one state per robot, short '
+                             'repeats and simulations (under a minute)')
+    parser.add_argument('--out', default='docs', metavar='DIR',
+                        help='where the report goes (default: docs)')
+    parser.add_argument('--robot', action='append', metavar='NAME',
+                        help='bundled robot to measure (repeatable; '
+                             'default: all bundled robots)')
+    parser.add_argument('--no-peers', dest='peers', action='store_false',
+                        help='leave Pinocchio and Robotics Toolbox out')
+    parser.add_argument('--no-scenes', dest='scenes', action='store_false',
+                        help='skip the scene and simulator measurements')
+    args = parser.parse_args(argv)
+
+    def log(line=''):
+        print(line, flush=True)
+
+    import numba
+    versions = {'python': platform.python_version(), 'numpy': np.__version__,
+                'numba': numba.__version__}
+    if args.peers:
+        versions.update(peers.versions())
+    log('newton_euler_ros accuracy vs time  ' + '  '.join(
+        f'{k} {v}' for k, v in versions.items()))
+    log(f'mode: {"quick (smoke test)" if args.quick else "full"}; '
+        f'float64 eps = {EPS:.3g}')
+    records, context = run(args, log)
+    context.update(versions=versions, quick=args.quick,
+                   date=datetime.date.today().isoformat(),
+                   machine=f'{platform.machine()}, {os.cpu_count()} cpus, '
+                           f'{platform.platform()}',
+                   command='python -m newton_euler_ros.accuracy'
+                           + (' --quick' if args.quick else ''))
+    from .markdown import write_report
+    path = write_report(records, context, args.out)
+    for note in context['notes']:
+        log(f'note: {note}')
+    log(f'\nwrote {path} (measurements took {context["elapsed_s"]:.0f} s)')
+    return 0
+
+
+def save_records(records, context, path):
+    """Write every record and the context as JSON."""
+    def default(x):
+        if isinstance(x, (np.floating, np.integer, np.bool_)):
+            return x.item()
+        if isinstance(x, np.ndarray):
+            return x.tolist()
+        raise TypeError(f'not JSON serialisable: {type(x).__name__}')
+    with open(path, 'w', encoding='utf-8') as fh:
+        json.dump({'context': context, 'records': records}, fh, indent=1,
+                  default=default)
+
+
+if __name__ == '__main__':
+    sys.exit(main())
