@@ -158,3 +158,19 @@ def test_quick_report_errors_are_physically_ordered(quick_report):
             assert 1e3 * EPS < err < 1e-7 * 100 * n, (robot, q, m, err)
         fd = _arith(records, robot, 'C', 'central differences of D')
         assert 1e3 * EPS < fd['error'] < 1e-6, (robot, fd['error'])
+
+
+def test_report_rerenders_from_its_records(quick_report, tmp_path):
+    out, _, _, _ = quick_report
+    proc = subprocess.run(
+        [sys.executable, '-m', 'newton_euler_ros.accuracy', '--from-records',
+         str(out / 'accuracy' / 'records.json'), '--out', str(tmp_path)],
+        capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    again = (tmp_path / 'accuracy-vs-time.md').read_text(encoding='utf-8')
+    assert again == (out / 'accuracy-vs-time.md').read_text(encoding='utf-8')
+    bad = subprocess.run(
+        [sys.executable, '-m', 'newton_euler_ros.accuracy', '--from-records',
+         str(tmp_path / 'missing.json')], capture_output=True, text=True,
+        timeout=300)
+    assert bad.returncode == 2 and 'cannot read records' in bad.stderr

@@ -136,6 +136,16 @@ def findings(records, context):
                    "over Pinocchio's: " + '; '.join(lines) + '.')
     # scaling
     exps = context.get('exponents', {})
+    tau3 = find(records, section='scaling', method='tau')
+    bat3 = find(records, section='scaling', method='tau, batched (per state)')
+    if exps and tau3 and bat3:
+        out.append(
+            f'- **A call from Python has a fixed cost.** At n = '
+            f'{tau3["dof"]} one tau takes {fmt_us(tau3["us"])} us alone and '
+            f'{fmt_us(bat3["us"])} us per state batched: the difference is '
+            f'argument checking and dispatch, the same for every n, which '
+            f'flattens the single-call exponents below; the batched '
+            "exponent is the algorithm's.")
     if exps:
         out.append('- **Growth with n** (fitted exponents, n >= '
                    f'{context["fit_from"]}): ' + '; '.join(
@@ -216,6 +226,9 @@ def render(records, context, images, scaling_img, scene_imgs, integ_img):
         '- In the plots, lower left is better; the dashed red line is the '
         'Pareto front (no other method is both faster and more accurate). '
         'Exact results (error 0) sit on the bottom line.',
+        '- Differences of a few eps between float64 methods are round-off '
+        'noise, not a ranking: every float64 method here is accurate to '
+        'the last few bits.',
         '- Peers (Pinocchio, Robotics Toolbox for Python) run models built '
         'from ours by `newton_euler_ros.peers`; their error includes '
         'rebuilding the DH geometry as transforms.',
@@ -262,7 +275,7 @@ def render(records, context, images, scaling_img, scene_imgs, integ_img):
     if tables:
         lines += ['## Scenes: model fidelity, batching, feedforward, '
                   'integrators', '']
-        for title, header, rows in tables:
+        for title, header, rows, notes in tables:
             lines += [f'### {title[0].upper()}{title[1:]}', '',
                       md_table(header, rows), '']
             if title.startswith('effect subsets'):
@@ -270,8 +283,6 @@ def render(records, context, images, scaling_img, scene_imgs, integ_img):
                 lines += ['']
             if title.startswith('integrators') and integ_img:
                 lines += [f'![integrators]({integ_img})', '']
-        notes = sorted({f'{r["section"]}: {r["note"]}' for r in records
-                        if r.get('scene') and r.get('note')})
-        if notes:
-            lines += ['Notes:', ''] + [f'- {n}' for n in notes] + ['']
+            if notes:
+                lines += [f'- {n}' for n in notes] + ['']
     return '\n'.join(lines)

@@ -56,16 +56,22 @@ def pareto_front(points):
 
 
 def _panel(ax, points, title, xlabel='microseconds per call',
-           ylabel='relative error vs 50-digit truth'):
-    """Scatter (us, error, label, family) points with their front."""
-    for us, err, label, family in points:
+           ylabel='relative error vs 50-digit truth', floor=ERROR_FLOOR):
+    """
+    Scatter (us, error, label, family) points with their Pareto front.
+
+    An error of 0 is drawn at ``floor``; labels of points that share a
+    region are staggered so that they stay readable.
+    """
+    for k, (us, err, label, family) in enumerate(
+            sorted(points, key=lambda p: (p[1], p[0]))):
         color, marker = FAMILY_STYLE.get(family, ('black', 'x'))
-        y = max(err, ERROR_FLOOR)
+        y = max(err, floor)
         ax.scatter([us], [y], color=color, marker=marker, s=36, zorder=3)
-        text = label if err > 0 else f'{label} (exact)'
+        text = label if err > 0 else f'{label} (exact: 0)'
         ax.annotate(text, (us, y), textcoords='offset points',
-                    xytext=(4, 3), fontsize=7)
-    front = pareto_front([(max(p[0], 1e-9), max(p[1], ERROR_FLOOR))
+                    xytext=(5, 3 - 9 * (k % 3)), fontsize=7)
+    front = pareto_front([(max(p[0], 1e-9), max(p[1], floor))
                           for p in points])
     if len(front) > 1:
         xs = []
@@ -117,10 +123,13 @@ def model_pareto(records, scene, path):
     rows = [r for r in records if r['section'] == 'effects'
             and r['scene'] == scene and r.get('error') is not None
             and r.get('us') is not None]
-    fig, ax = plt.subplots(figsize=(7, 4.8))
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    nonzero = [r['error'] for r in rows if r['error'] > 0]
+    floor = min(nonzero) / 10 if nonzero else ERROR_FLOOR
     _panel(ax, [(r['us'], r['error'], r['method'], 'model') for r in rows],
            f'{scene}: torque error of a simplified model along the '
-           f'scene trajectory', ylabel='RMS torque error / RMS torque')
+           f'scene trajectory', ylabel='RMS torque error / RMS torque',
+           floor=floor)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

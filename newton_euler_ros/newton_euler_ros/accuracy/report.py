@@ -17,6 +17,7 @@ Run every measurement; print the table; write the report and its plots.
 
     python -m newton_euler_ros.accuracy [--quick] [--out DIR] [--no-peers]
                                         [--robot NAME ...] [--no-scenes]
+    python -m newton_euler_ros.accuracy --from-records JSON [--out DIR]
 
 Writes ``DIR/accuracy-vs-time.md`` (default ``docs/``), its PNGs under
 ``DIR/accuracy/`` and every record as ``DIR/accuracy/records.json``.
@@ -175,7 +176,7 @@ def run(args, log):
             'integrators ===')
         scene_records = scenes.run_all(args.quick)
         records += scene_records
-        for title, header, rows in scene_tables(scene_records):
+        for title, header, rows, _ in scene_tables(scene_records):
             log(f'\n--- {title} ---')
             log(text_table(header, rows))
     context = {'notes': notes, 'exponents': exponents, 'sizes': sizes,
@@ -211,34 +212,47 @@ def scaling_text(records, exponents, sizes):
                       scaling_rows(records, exponents, sizes))
 
 
+def _notes(rows):
+    """Return the distinct notes of ``rows``, per scene, in order."""
+    out = []
+    for r in rows:
+        line = f'{r["scene"]}: {r["note"]}' if r.get('note') else ''
+        if line and line not in out:
+            out.append(line)
+    return out
+
+
 def scene_tables(records):
-    """[(title, header, rows)] for the scene sections that have records."""
+    """[(title, header, rows, notes)] for the scene sections measured."""
     tables = []
     eff = [r for r in records if r['section'] == 'effects']
     if eff:
         tables.append((
             'effect subsets: cost and torque error along the scene '
-            'trajectory (truth: full + wrench)',
+            "trajectory (truth: full + wrench; * the scene's own model)",
             ['scene', 'model', 'us/call', 'RMS error / RMS torque',
              'max error (N m or N)'],
-            [[r['scene'], r['method'], fmt_us(r['us']), fmt_err(r['error']),
-              fmt_err(r.get('abs_error'))] for r in eff]))
+            [[r['scene'], r['method'] + (' *' if r.get('scene_model')
+                                         else ''),
+              fmt_us(r['us']), fmt_err(r['error']),
+              fmt_err(r.get('abs_error'))] for r in eff], _notes(eff)))
     bat = [r for r in records if r['section'] == 'batch']
     if bat:
         tables.append((
             'single state vs batched over the trajectory',
             ['scene', 'method', 'us/state', 'max |difference| (relative)'],
             [[r['scene'], r['method'], fmt_us(r['us']), fmt_err(r['error'])]
-             for r in bat]))
+             for r in bat], _notes(bat)))
     ff = [r for r in records if r['section'] == 'feedforward']
     if ff:
         tables.append((
             'feedforward at the desired vs the measured state',
             ['scene', 'feedforward', 'us/step', 'tracking RMS (rad)',
-             'tracking max (rad)'],
+             'RMS, second half', 'tracking max (rad)'],
             [[r['scene'], r['method'], fmt_us(r['us']),
-              fmt_err(r.get('tracking_rms')), fmt_err(r.get('tracking_max'))]
-             for r in ff]))
+              fmt_err(r.get('tracking_rms')),
+              fmt_err(r.get('tracking_rms_late')),
+              fmt_err(r.get('tracking_max'))] for r in ff], _notes(ff)))
     integ = [r for r in records if r['section'] == 'integrators']
     if integ:
         tables.append((
@@ -249,7 +263,7 @@ def scene_tables(records):
             [[r['scene'], r['method'], f'{r["step"] * 1e3:g}',
               fmt_us(r['us']), f'{r["cost"]:.3g}', fmt_err(r['error']),
               fmt_err(r['drift']), fmt_err(r.get('tracking_rms'))]
-             for r in integ]))
+             for r in integ], _notes(integ)))
     return tables
 
 
@@ -275,7 +289,12 @@ def main(argv=None):
                         help='leave Pinocchio and Robotics Toolbox out')
     parser.add_argument('--no-scenes', dest='scenes', action='store_false',
                         help='skip the scene and simulator measurements')
+    parser.add_argument('--from-records', metavar='JSON',
+                        help='measure nothing: rewrite the report and its '
+                             'plots from the records.json of an earlier run')
     args = parser.parse_args(argv)
+    if args.from_records:
+        return rerender(args.from_records, args.out)
 
     def log(line=''):
         print(line, flush=True)
@@ -301,6 +320,23 @@ def main(argv=None):
     for note in context['notes']:
         log(f'note: {note}')
     log(f'\nwrote {path} (measurements took {context["elapsed_s"]:.0f} s)')
+    return 0
+
+
+def rerender(path, out_dir):
+    """Rewrite the report from saved records; return the exit status."""
+    from .markdown import write_report
+    try:
+        with open(path, encoding='utf-8') as fh:
+            data = json.load(fh)
+        records, context = data['records'], data['context']
+        context['exponents'] = {k: tuple(v) for k, v in
+                                context['exponents'].items()}
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        print(f'error: cannot read records from {path}: {exc}',
+              file=sys.stderr)
+        return 2
+    print(f'wrote {write_report(records, context, out_dir)} from {path}')
     return 0
 
 

@@ -31,7 +31,7 @@ from .chains import random_chain, random_states
 from ..core import (coriolis_matrix, gravity_torques, inverse_dynamics,
                     inverse_dynamics_batch, mass_matrix, Workspace)
 
-FULL_SIZES = (3, 6, 12, 25, 50, 100)
+FULL_SIZES = (3, 6, 12, 25, 50, 100, 200)
 QUICK_SIZES = (3, 6, 12, 25)
 FIT_POINTS = 3
 BATCH = 200
