@@ -35,6 +35,7 @@ import warnings
 
 from hypothesis import given, HealthCheck, settings, strategies as st
 import mpmath
+from newton_euler_ros.accuracy.chains import random_chain, random_inertia
 from newton_euler_ros.core import (bundled_robots, coriolis_matrix,
                                    DynamicsInputError, forward_dynamics,
                                    gravity_torques, inverse_dynamics,
@@ -88,34 +89,12 @@ def _robot(name):
         return load_robot(name)
 
 
-def _inertia(rng, mass, size):
-    """Return a random physical inertia about the com (PSD, triangle ok)."""
-    second = mass * rng.uniform(0.05, 1.0, 3) * size ** 2
-    principal = np.array([second[1] + second[2], second[0] + second[2],
-                          second[0] + second[1]])
-    R = rpy_matrix(*rng.uniform(-math.pi, math.pi, 3))
-    return R @ np.diag(principal) @ R.T
-
-
 def _random_chain(n, seed, convention='standard', prismatic=0.3,
                   masses=None, name='chain'):
     """Build a seeded random DH chain with mixed joints."""
-    rng = np.random.default_rng(seed)
-    types = ['prismatic' if rng.random() < prismatic else 'revolute'
-             for _ in range(n)]
-    alpha = rng.choice([0.0, math.pi / 2, -math.pi / 2, 1.0], n)
-    alpha = np.where(alpha == 1.0, rng.uniform(-math.pi, math.pi, n), alpha)
-    mass = rng.uniform(0.5, 5.0, n) if masses is None else np.asarray(masses)
-    size = rng.uniform(0.05, 0.3, n)
-    inertia = np.array([_inertia(rng, m, s) for m, s in zip(mass, size)])
-    return make_model(
-        name, convention, [f'j{k}' for k in range(n)], types,
-        a=rng.uniform(-0.3, 0.3, n), alpha=alpha,
-        d=rng.uniform(-0.3, 0.3, n), theta=rng.uniform(-math.pi, math.pi, n),
-        mass=mass, com=rng.uniform(-0.15, 0.15, (n, 3)), inertia=inertia,
-        gravity=(0.0, 0.0, -9.81),
-        tool=pose_matrix(rng.uniform(-0.1, 0.1, 3),
-                         rng.uniform(-math.pi, math.pi, 3)))
+    return random_chain(n, convention=convention, prismatic=prismatic,
+                        masses=masses, name=name,
+                        rng=np.random.default_rng(seed))
 
 
 def _state(model, rng, scale=1.0):
@@ -567,7 +546,7 @@ def robots_and_states(draw):
         a=rng.uniform(-0.5, 0.5, n), alpha=rng.uniform(-math.pi, math.pi, n),
         d=rng.uniform(-0.5, 0.5, n), theta=rng.uniform(-math.pi, math.pi, n),
         mass=mass, com=rng.uniform(-0.2, 0.2, (n, 3)),
-        inertia=np.array([_inertia(rng, m, s) for m, s in zip(mass, size)]),
+        inertia=np.array([random_inertia(rng, m, s) for m, s in zip(mass, size)]),
         gravity=rng.normal(size=3) * 5.0, tool=tool,
         base=pose_matrix(rng.uniform(-0.5, 0.5, 3),
                          rng.uniform(-math.pi, math.pi, 3)))

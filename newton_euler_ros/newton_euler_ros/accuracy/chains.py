@@ -27,7 +27,7 @@ import numpy as np
 from ..core.model import make_model, pose_matrix, rpy_matrix
 
 
-def _inertia(rng, mass, size):
+def random_inertia(rng, mass, size):
     """Return a random physical inertia about the com (a rotated box)."""
     second = mass * rng.uniform(0.05, 1.0, 3) * size ** 2
     principal = np.array([second[1] + second[2], second[0] + second[2],
@@ -36,23 +36,28 @@ def _inertia(rng, mass, size):
     return R @ np.diag(principal) @ R.T
 
 
-def random_chain(n, seed=0, convention='standard', prismatic=0.2):
+def random_chain(n, seed=0, convention='standard', prismatic=0.2,
+                 masses=None, name=None, rng=None):
     """
     Return a random n-link chain, about a fifth of its joints prismatic.
 
-    Links are 0.05-0.3 m with 0.5-5 kg, so a 100-link chain is long and
-    heavy, as the stress of a long chain should be.
+    Links are 0.05-0.3 m with 0.5-5 kg (or the given ``masses``), so a
+    100-link chain is long and heavy, as the stress of a long chain should
+    be.  The draws come from ``rng`` when given (the stress tests pass
+    their own), else from a generator seeded by (n, seed).
     """
-    rng = np.random.default_rng([n, seed])
+    if rng is None:
+        rng = np.random.default_rng([n, seed])
     types = ['prismatic' if rng.random() < prismatic else 'revolute'
              for _ in range(n)]
     alpha = rng.choice([0.0, math.pi / 2, -math.pi / 2, 1.0], n)
     alpha = np.where(alpha == 1.0, rng.uniform(-math.pi, math.pi, n), alpha)
-    mass = rng.uniform(0.5, 5.0, n)
+    mass = (rng.uniform(0.5, 5.0, n) if masses is None
+            else np.asarray(masses, dtype=float))
     size = rng.uniform(0.05, 0.3, n)
-    inertia = np.array([_inertia(rng, m, s) for m, s in zip(mass, size)])
+    inertia = np.array([random_inertia(rng, m, s) for m, s in zip(mass, size)])
     return make_model(
-        f'chain{n}', convention, [f'j{k}' for k in range(n)], types,
+        name or f'chain{n}', convention, [f'j{k}' for k in range(n)], types,
         a=rng.uniform(-0.3, 0.3, n), alpha=alpha,
         d=rng.uniform(-0.3, 0.3, n), theta=rng.uniform(-math.pi, math.pi, n),
         mass=mass, com=rng.uniform(-0.15, 0.15, (n, 3)), inertia=inertia,

@@ -53,24 +53,34 @@ def _ratio(records, robot, quantity, method, base):
     return a['us'] / b['us'], a, b
 
 
+def _compare(records, pairs):
+    """
+    Compare method a with method b over (robot, quantity, a, b) tuples.
+
+    Return (time ratios a/b, errors of a, errors of b, dofs) over the
+    pairs that were both measured.
+    """
+    out = ([], [], [], [])
+    for robot, quantity, a, b in pairs:
+        ratio, ra, rb = _ratio(records, robot, quantity, a, b)
+        if ratio is not None:
+            for column, value in zip(out, (ratio, ra['error'], rb['error'],
+                                           (ra['dof'], robot))):
+                column.append(value)
+    return out
+
+
+BASE_METHOD = {'tau': 'float64', 'D': 'float64, CRBA', 'C': 'float64, exact',
+               'g': 'float64'}
+
+
 def findings(records, context):
     """Return the findings as markdown bullet lines, computed from records."""
     robots = _robots(records)
     out = []
-    # float32
-    t_ratio = []
-    errs32 = []
-    errs64 = []
-    for robot in robots:
-        for q in ('tau', 'D', 'C', 'g'):
-            base = 'float64' if q in ('tau', 'g') else (
-                'float64, CRBA' if q == 'D' else 'float64, exact')
-            m32 = base.replace('float64', 'float32')
-            ratio, a, b = _ratio(records, robot, q, m32, base)
-            if ratio is not None:
-                t_ratio.append(ratio)
-                errs32.append(a['error'])
-                errs64.append(b['error'])
+    t_ratio, errs32, errs64, _ = _compare(records, [
+        (robot, q, base.replace('float64', 'float32'), base)
+        for robot in robots for q, base in BASE_METHOD.items()])
     if t_ratio:
         typical = sorted(t_ratio)[len(t_ratio) // 2]
         verdict = ('float32 buys no time' if typical > 0.9 else
@@ -82,36 +92,20 @@ def findings(records, context):
             f'float32 operation costs what one float64 operation costs), '
             f'while its error is {_span(errs32, fmt_err)} against '
             f'{_span(errs64, fmt_err)} in float64.')
-    # CRBA
-    t_ratio = []
-    e_crba = []
-    e_ne = []
-    for robot in robots:
-        ratio, a, b = _ratio(records, robot, 'D', 'float64, CRBA',
-                             'float64, n recursions')
-        if ratio is not None:
-            t_ratio.append((ratio, robot, a['dof']))
-            e_crba.append(a['error'])
-            e_ne.append(b['error'])
+    t_ratio, e_crba, e_ne, dofs = _compare(records, [
+        (robot, 'D', 'float64, CRBA', 'float64, n recursions')
+        for robot in robots])
     if t_ratio:
-        big = max(t_ratio, key=lambda x: x[2])
+        k = max(range(len(dofs)), key=lambda i: dofs[i][0])
         out.append(
             f'- **D(q): the composite-rigid-body algorithm** takes '
-            f'{_span([x[0] for x in t_ratio], lambda x: f"{x:.2f}x")} the '
-            f'time of n Newton-Euler recursions ({big[0]:.2f}x on '
-            f'{big[1]}, {big[2]} links), at an error of '
-            f'{_span(e_crba, fmt_err)} against {_span(e_ne, fmt_err)}.')
-    # finite differences
-    t_ratio = []
-    e_fd = []
-    e_ex = []
-    for robot in robots:
-        ratio, a, b = _ratio(records, robot, 'C', 'central differences of D',
-                             'float64, exact')
-        if ratio is not None:
-            t_ratio.append(ratio)
-            e_fd.append(a['error'])
-            e_ex.append(b['error'])
+            f'{_span(t_ratio, lambda x: f"{x:.2f}x")} the time of n '
+            f'Newton-Euler recursions ({t_ratio[k]:.2f}x on {dofs[k][1]}, '
+            f'{dofs[k][0]} links), at an error of {_span(e_crba, fmt_err)} '
+            f'against {_span(e_ne, fmt_err)}.')
+    t_ratio, e_fd, e_ex, _ = _compare(records, [
+        (robot, 'C', 'central differences of D', 'float64, exact')
+        for robot in robots])
     if t_ratio:
         out.append(
             f'- **C(q, qd) by finite differences of D** costs '
