@@ -114,20 +114,21 @@ def findings(records, context):
             f'differences at the optimal step) against '
             f'{_span(e_ex, fmt_err)} exact.')
     # peers
-    lines = []
-    for q, ours, peer in (('tau', 'float64', 'Pinocchio rnea'),
-                          ('D', 'float64, CRBA', 'Pinocchio crba'),
-                          ('C', 'float64, exact',
-                           'Pinocchio computeCoriolisMatrix'),
-                          ('g', 'float64', 'Pinocchio computeGeneralizedGravity'
-                           )):
-        ratio, a, b = _ratio(records, HEADLINE_ROBOT, q, ours, peer)
-        if ratio is not None:
-            lines.append(f'{q} {ratio:.2f}x (error {fmt_err(a["error"])} vs '
-                         f'{fmt_err(b["error"])})')
-    if lines:
-        out.append(f'- **Against Pinocchio** on {HEADLINE_ROBOT}, our time '
-                   "over Pinocchio's: " + '; '.join(lines) + '.')
+    arith = [r for r in records if r['section'] == 'arithmetic']
+    largest = max(arith, key=lambda r: r['dof'])['robot'] if arith else None
+    for robot in dict.fromkeys((HEADLINE_ROBOT, largest)):
+        lines = []
+        for q, peer in (('tau', 'Pinocchio rnea'), ('D', 'Pinocchio crba'),
+                        ('C', 'Pinocchio computeCoriolisMatrix'),
+                        ('g', 'Pinocchio computeGeneralizedGravity')):
+            ratio, a, b = _ratio(records, robot, q, BASE_METHOD[q], peer)
+            if ratio is not None:
+                lines.append(f'{q} {ratio:.2f}x (error '
+                             f'{fmt_err(a["error"])} vs '
+                             f'{fmt_err(b["error"])})')
+        if lines:
+            out.append(f'- **Against Pinocchio** on {robot}, our time over '
+                       "Pinocchio's: " + '; '.join(lines) + '.')
     # scaling
     exps = context.get('exponents', {})
     tau3 = find(records, section='scaling', method='tau')
