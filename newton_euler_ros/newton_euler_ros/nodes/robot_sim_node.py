@@ -61,6 +61,7 @@ FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
 GRACE = 1.0     # seconds between seeing a controller and starting
 LEAD = 0.5      # seconds between announcing the start time and t = 0
 FIRST_COMMAND = 1.0     # seconds t = 0 is held for the first command
+FUTURE = 1.0    # seconds: a live wrench stamped further ahead is dropped
 
 
 def advance(dyn, q, qd, tau, t, period, dt, method):
@@ -250,15 +251,26 @@ class RobotSimNode(Node):
         self.state_pub.publish(msg)
 
     def _on_wrench(self, msg):
-        """Apply a live wrench (frame_id base_link/base or tool0/...)."""
+        """
+        Apply a live wrench (frame_id base_link/base or tool0/...).
+
+        It holds until the next one; one stamped more than FUTURE seconds
+        ahead of this node's clock is dropped.
+        """
         frame = FRAME_OF.get(msg.header.frame_id)
         f, n = msg.wrench.force, msg.wrench.torque
         w = np.array([f.x, f.y, f.z, n.x, n.y, n.z])
-        if frame is None or not np.isfinite(w).all():
+        stamp = msg.header.stamp
+        ahead = (stamp.sec + stamp.nanosec * 1e-9
+                 - self.get_clock().now().nanoseconds * 1e-9)
+        if frame is None or not np.isfinite(w).all() or ahead > FUTURE:
+            # a clock running ahead is as wrong as a bad frame (as for
+            # inverse_dynamics_node); unstamped (0) wrenches are taken
             self.dropped += 1
             self.get_logger().warning(
                 f'dropped wrench in frame {msg.header.frame_id!r} '
-                f'(frames: {sorted(FRAME_OF)}) or non-finite: {w.tolist()}',
+                f'(frames: {sorted(FRAME_OF)}), non-finite or stamped more '
+                f'than {FUTURE} s ahead ({ahead:.3f} s): {w.tolist()}',
                 throttle_duration_sec=2.0)
             return
         self.dyn.live_wrench = w
