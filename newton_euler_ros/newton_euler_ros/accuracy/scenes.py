@@ -47,7 +47,8 @@ from ..bench import Timer
 from ..core import inverse_dynamics, inverse_dynamics_batch, Workspace
 from ..core.robot_file import RobotFileWarning
 from ..core.scene import INTEGRATORS, load_scene
-from ..core.simulate import SceneDynamics, simulate, tracking_controller
+from ..core.simulate import (integrator_step, SceneDynamics, simulate,
+                             tracking_controller)
 
 SCENES = ('puma_payload_press', 'panda_orbit_slow', 'panda_slow_earth')
 CONTROL_PERIOD = 4e-3          # s: the sweep's controller, 250 Hz, held
@@ -175,36 +176,6 @@ def held_controller(dyn, period, feedforward=None, feedforward_at='desired'):
             held['out'] = inner(t, q, qd)
         return held['out']
     return control
-
-
-def integrator_step(dyn, method):
-    """
-    Return ``step(q, qd, tau, t, h) -> (q, qd)``: one integrator step.
-
-    The arithmetic of :func:`simulate` (and of the simulator node) without
-    its energy bookkeeping: four accelerations for 'rk4', one for
-    'semi_implicit_euler'.
-    """
-    acc = dyn.accelerations
-    if method == 'rk4':
-        def step(q, qd, tau, t, h):
-            a1 = acc(q, qd, tau, t)
-            q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
-            a2 = acc(q2, v2, tau, t + 0.5 * h)
-            q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
-            a3 = acc(q3, v3, tau, t + 0.5 * h)
-            q4, v4 = q + h * v3, qd + h * a3
-            a4 = acc(q4, v4, tau, t + h)
-            return (q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4),
-                    qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4))
-    elif method == 'semi_implicit_euler':
-        def step(q, qd, tau, t, h):
-            qd = qd + h * acc(q, qd, tau, t)
-            return q + h * qd, qd
-    else:
-        raise ValueError(f'integrator must be one of {", ".join(INTEGRATORS)}'
-                         f', got {method!r}')
-    return step
 
 
 def fit_order(steps, errors, floor):
@@ -539,8 +510,9 @@ def integrator_sweep(scene, quick=False, steps=None, duration=None,
           'h': steps[0]}
     entries = {}
     for method in INTEGRATORS:
-        ns_m = dict(ns, step=integrator_step(dyn, method))
-        entries[method] = ('step(q, qd, tau, t, h)', ns_m, None, 1)
+        ns_m = dict(ns, step=integrator_step, dyn=dyn, method=method)
+        entries[method] = ('step(dyn, method, q, qd, tau, t, h)', ns_m,
+                           None, 1)
     times = Timer(quick).group(entries)
 
     results = {}

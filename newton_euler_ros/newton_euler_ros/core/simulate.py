@@ -35,6 +35,7 @@ from . import _kernels as K
 from .dynamics import (inverse_dynamics, jacobian, link_poses, mass_matrix,
                        Workspace)
 from .errors import NotPositiveDefiniteError
+from .scene import INTEGRATORS
 
 
 class SceneDynamics:
@@ -136,6 +137,33 @@ class SceneDynamics:
             w, frame = self.wrench(t)
             p_w = -(jacobian(self.model, q, frame, ws=self.ws) @ qd) @ w
         return p_tau, p_f, p_w
+
+
+def integrator_step(dyn, method, q, qd, tau, t, h):
+    """
+    Return (q, qd) one step of ``h`` later, holding the torques ``tau``.
+
+    ``method`` is 'rk4' (four forward-dynamics calls) or
+    'semi_implicit_euler' (one).  The stepping of the simulator node and
+    of the integrator measurements; :func:`simulate` does the same
+    arithmetic and also integrates the power for its energy bookkeeping.
+    """
+    acc = dyn.accelerations
+    if method == 'rk4':
+        a1 = acc(q, qd, tau, t)
+        q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
+        a2 = acc(q2, v2, tau, t + 0.5 * h)
+        q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
+        a3 = acc(q3, v3, tau, t + 0.5 * h)
+        q4, v4 = q + h * v3, qd + h * a3
+        a4 = acc(q4, v4, tau, t + h)
+        return (q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4),
+                qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4))
+    if method == 'semi_implicit_euler':
+        qd = qd + h * acc(q, qd, tau, t)
+        return q + h * qd, qd
+    raise ValueError(f'integrator must be one of {", ".join(INTEGRATORS)}, '
+                     f'got {method!r}')
 
 
 FEEDFORWARD_AT = ('desired', 'measured')

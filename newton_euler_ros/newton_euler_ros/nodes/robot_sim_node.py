@@ -53,7 +53,7 @@ from std_msgs.msg import Float64MultiArray, Header
 from .common import ConfigurationError, declare, qos_profile, run_node
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
-from ..core.simulate import SceneDynamics
+from ..core.simulate import integrator_step, SceneDynamics
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -75,20 +75,7 @@ def advance(dyn, q, qd, tau, t, period, dt, method):
     steps = max(1, int(math.ceil(period / dt - 1e-9)))
     h = period / steps
     for k in range(steps):
-        s = t + k * h
-        if method == 'rk4':
-            a1 = dyn.accelerations(q, qd, tau, s)
-            q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
-            a2 = dyn.accelerations(q2, v2, tau, s + 0.5 * h)
-            q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
-            a3 = dyn.accelerations(q3, v3, tau, s + 0.5 * h)
-            q4, v4 = q + h * v3, qd + h * a3
-            a4 = dyn.accelerations(q4, v4, tau, s + h)
-            q = q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4)
-            qd = qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-        else:   # semi-implicit (symplectic) Euler
-            qd = qd + h * dyn.accelerations(q, qd, tau, s)
-            q = q + h * qd
+        q, qd = integrator_step(dyn, method, q, qd, tau, t + k * h, h)
     return q, qd
 
 
