@@ -123,16 +123,8 @@ def wrench_series(scene, T):
     """
     if not scene.effects.wrench:
         return None, 'base'
-    w = scene.wrench
-    T = np.asarray(T, dtype=float)
-    if w.kind == 'topic':
-        W = np.zeros((T.size, 6))
-    elif len(w.times) == 1:
-        W = np.repeat(w.values[:1], T.size, axis=0)
-    else:
-        W = np.stack([np.interp(T, w.times, w.values[:, k])
-                      for k in range(6)], axis=1)
-    return np.ascontiguousarray(W), w.frame
+    W = np.array([scene.wrench.at(t) for t in np.asarray(T, dtype=float)])
+    return np.ascontiguousarray(W.reshape(-1, 6)), scene.wrench.frame
 
 
 def scene_torques_batch(scene, Q, QD, QDD, W=None, frame='base', ws=None,
