@@ -13,11 +13,15 @@
 # limitations under the License.
 
 """
-An independent Euler-Lagrange reference for serial DH arms (test oracle).
+An independent Euler-Lagrange reference for serial arms (test oracle).
 
 Nothing here is imported from ``newton_euler_ros``: the only coupling is that
 the functions read the public fields of a model object (``a, alpha, d,
-theta, joint_types, convention, mass, com, inertia, gravity, base, tool``).
+theta, joint_types, convention, mass, com, inertia, gravity, base, tool``
+for DH arms; ``joint_pre, joint_axis, joint_post`` for general ones, e.g.
+from URDF: each joint is Pre . M(axis, q) . Post, with M a rotation about
+the axis by Rodrigues' formula or a translation along it, and Pre/Post
+products of the elementary operations, all evaluated here).
 The kinematics are products of elementary 4x4 homogeneous matrices, the
 dynamics come from the Lagrangian
 
@@ -102,6 +106,59 @@ def trans_z(d):
     return T
 
 
+def rot_y(t):
+    c, s = np.cos(t), np.sin(t)
+    T = np.eye(4, dtype=_dtype(t))
+    T[0, 0], T[0, 2], T[2, 0], T[2, 2] = c, s, -s, c
+    return T
+
+
+def translation(x, y, z):
+    T = np.eye(4, dtype=_dtype(x, y, z))
+    T[:3, 3] = x, y, z
+    return T
+
+
+def ops_transform(ops):
+    """4x4 product of a model's elementary operations, evaluated here."""
+    T = np.eye(4)
+    for op in ops:
+        kind, args = op[0], op[1:]
+        if kind in ('tx', 'ty', 'tz'):
+            v = [0.0, 0.0, 0.0]
+            v['xyz'.index(kind[1])] = args[0]
+            E = translation(*v)
+        elif kind in ('rx', 'ry', 'rz'):
+            E = {'rx': rot_x, 'ry': rot_y, 'rz': rot_z}[kind](args[0])
+        elif kind == 'xyz':
+            E = translation(*args)
+        elif kind == 'rpy':
+            E = rot_z(args[2]) @ rot_y(args[1]) @ rot_x(args[0])
+        elif kind == 'matrix':
+            E = np.eye(4)
+            E[:3, :3] = np.reshape(args[:9], (3, 3))
+            E[:3, 3] = args[9:]
+        else:
+            raise ValueError(kind)
+        T = T @ E
+    return T
+
+
+def axis_motion(joint_type, axis, q):
+    """Rotation about (Rodrigues) or translation along a unit axis by q."""
+    k = np.asarray(axis, dtype=float)
+    k = k / np.sqrt(k @ k)
+    T = np.eye(4, dtype=_dtype(q))
+    if joint_type == REVOLUTE:
+        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
+                      [-k[1], k[0], 0.0]])
+        T[:3, :3] = (np.eye(3) + np.sin(q) * K
+                     + (1.0 - np.cos(q)) * (K @ K))
+    else:
+        T[:3, 3] = k * q
+    return T
+
+
 def dh_transform(convention, a, alpha, d, theta):
     """
     Return the 4x4 DH transform of one joint in the given convention.
@@ -130,7 +187,18 @@ def forward_kinematics(model, q):
     dt = _dtype(q)
     T = [np.asarray(model.base, dtype=dt)]
     axes = []
+    dh = model.convention in (STANDARD, 'modified')
     for j in range(n):
+        if not dh:
+            # general joint: Pre . M(axis, q) . Post; the axis passes
+            # through the origin of Pre's frame
+            P = T[-1] @ ops_transform(model.joint_pre[j])
+            axes.append((P[:3, :3] @ np.asarray(model.joint_axis[j]),
+                         P[:3, 3]))
+            T.append(P @ axis_motion(model.joint_types[j],
+                                     model.joint_axis[j], q[j])
+                     @ ops_transform(model.joint_post[j]))
+            continue
         theta = model.theta[j]
         d = model.d[j]
         if model.joint_types[j] == REVOLUTE:

@@ -29,12 +29,11 @@ So float64 arrays give float64 arithmetic, float32 arrays give float32
 arithmetic throughout (``core.float32``; the tests check numba's type
 maps), and mpf object arrays give mpmath arithmetic (``core.highprec``).
 
-Notation (all vectors of link j are expressed in link frame j):
+Notation (all vectors of link j are expressed in kernel frame j, whose z
+axis is the axis of joint j through its origin O_j; see
+``model.compile_arrays``):
 
-- ``R``, ``p``: rotation and origin of link frame j in frame j-1.
-- ``u``: unit joint axis of joint j; ``s``: vector from the point K where
-  the axis passes to the origin O_j (both fixed in link j); ``rK``: vector
-  from O_{j-1} to K in frame j-1.
+- ``R``, ``p``: rotation and origin of kernel frame j in frame j-1.
 - ``w``: angular velocity (from qd); ``r``: the *reference* angular velocity
   (from the second velocity argument ``v``); ``al``: angular acceleration;
   ``ae``: acceleration of the point O_j; ``ac``: acceleration of the centre
@@ -50,14 +49,14 @@ with ``B(V) = (M ad_V - ad_V^T M - K(M V)) / 2``, which is skew-symmetric
 the true velocity-product torque).  Written at the centre of mass in
 3-vectors this becomes the classical recursion with
 ``w x (w x c)`` -> ``w x (r x c)``,
-``w_{j-1} x u qd_j`` -> ``r_{j-1} x u qd_j`` (revolute),
-``2 w x u qd_j`` -> ``(r x u) qd_j + (w x u) v_j`` (prismatic) and
+``w_{j-1} x z qd_j`` -> ``r_{j-1} x z qd_j`` (revolute),
+``2 w x z qd_j`` -> ``(r x z) qd_j + (w x z) v_j`` (prismatic) and
 ``w x I w`` -> ``(w x I r + r x I w + I (w x r)) / 2``.
 Every replacement reduces to the physical term exactly when ``v == qd``.
 
-The prismatic Coriolis term is ``2 w x u qd``: the seed's eqs. (15)-(18)
+The prismatic Coriolis term is ``2 w x z qd``: the seed's eqs. (15)-(18)
 keep only the ``zdot qd`` half and miss the half that comes from
-differentiating ``w x r`` while r grows at the rate ``u qd``.
+differentiating ``w x r`` while r grows at the rate ``z qd``.
 """
 import math
 
@@ -66,20 +65,19 @@ try:  # the high-precision reference injects its own (identity) decorator
 except NameError:
     from numba import njit
 
-# Columns of the per-link parameter array ``links`` (one row per joint).
+# Columns of the per-link parameter array ``links`` (one row per joint), in
+# kernel frames (see ``model.compile_arrays``): kernel frame j is kernel
+# frame j-1 moved by the constant placement (R, p), then by Rz(q_j)
+# (revolute) or Tz(q_j) (prismatic).  The joint axis is z of kernel frame
+# j and passes through its origin.
 L_TYPE = 0       # 0.0 revolute, 1.0 prismatic
-L_CONV = 1       # 0.0 standard DH, 1.0 modified DH
-L_A = 2
-L_CA = 3         # cos(alpha)
-L_SA = 4         # sin(alpha)
-L_D = 5          # d offset
-L_THETA = 6      # theta offset
-L_MASS = 7
-L_COM = 8        # 3 columns
-L_INERTIA = 11   # 9 columns, row-major, about the com in link-frame axes
-L_CT0 = 20       # cos(theta offset)
-L_ST0 = 21       # sin(theta offset)
-L_WIDTH = 22
+L_R = 1          # 9, row-major: placement rotation in kernel frame j-1
+L_P = 10         # 3: placement origin in kernel frame j-1
+L_MASS = 13
+L_COM = 14       # 3 columns, kernel frame j
+L_INERTIA = 17   # 9 columns, row-major, about the com in kernel-frame axes
+L_BODY = 26      # 12: R (9) then p (3) of link frame j in kernel frame j
+L_WIDTH = 38
 
 # Rows of the fixed-frame array ``frames`` (shape (F_ROWS, 12)).
 F_BASE = 0       # R (9, row-major) then p (3): DH frame 0 in the base frame
@@ -98,16 +96,14 @@ C_ONE = 2        # 1.0
 CONSTANTS = (0.0, 0.5, 1.0)
 
 # Columns of the workspace ``ws`` (one row per joint).
-W_R = 0          # 9
-W_P = 9          # 3
-W_U = 12         # 3
-W_S = 15         # 3
-W_F = 18         # 3 net force on link j (m * a_c)
-W_N = 21         # 3 net moment about the com
-W_CT = 24        # cos(theta_j)
-W_ST = 25        # sin(theta_j)
-W_DD = 26        # d_j
-W_WIDTH = 27
+W_R = 0          # 9: rotation of kernel frame j in kernel frame j-1
+W_P = 9          # 3: origin of kernel frame j in kernel frame j-1
+W_F = 12         # 3 net force on link j (m * a_c)
+W_N = 15         # 3 net moment about the com
+W_CT = 18        # cos(q_j) (1 for a prismatic joint)
+W_ST = 19        # sin(q_j) (0 for a prismatic joint)
+W_DD = 20        # q_j for a prismatic joint (0 for a revolute one)
+W_WIDTH = 21
 
 # Returned when finite inputs overflow float64 in the result.
 OVERFLOW = 9000
@@ -132,56 +128,54 @@ def _revolute(links, frames, j):
 @njit(cache=True)
 def joint_trig(links, frames, q, ws):
     """
-    Fill cos(theta_j), sin(theta_j), d_j of every joint into ``ws``.
+    Fill cos(q_j), sin(q_j) and the slide of every joint into ``ws``.
 
-    A revolute angle is q + theta_offset; its cosine and sine come from
-    the angle-addition formulas with the offset's cosine and sine computed
-    once, so a large q is not first rounded by the sum (q + offset would
-    lose |q| eps).  A prismatic joint needs no trigonometry per call.
+    A revolute joint's constant offset is part of its placement, so its
+    angle is q itself: a large q is never rounded by adding an offset.
+    A prismatic joint needs no trigonometry per call.
     """
     n = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    one = frames[F_CONST, C_ONE]
     for j in range(n):
-        ct0 = links[j, L_CT0]
-        st0 = links[j, L_ST0]
         if _revolute(links, frames, j):
-            cq = math.cos(q[j])
-            sq = math.sin(q[j])
-            ws[j, W_CT] = cq * ct0 - sq * st0
-            ws[j, W_ST] = sq * ct0 + cq * st0
-            ws[j, W_DD] = links[j, L_D]
+            ws[j, W_CT] = math.cos(q[j])
+            ws[j, W_ST] = math.sin(q[j])
+            ws[j, W_DD] = zero
         else:
-            ws[j, W_CT] = ct0
-            ws[j, W_ST] = st0
-            ws[j, W_DD] = links[j, L_D] + q[j]
+            ws[j, W_CT] = one
+            ws[j, W_ST] = zero
+            ws[j, W_DD] = q[j]
 
 
 @njit(cache=True)
 def _link_geometry(links, frames, j, ws):
-    """R, p, u, s and rK of joint j from the trig values in ``ws``."""
-    ct = ws[j, W_CT]
-    st = ws[j, W_ST]
+    """
+    R, p of kernel frame j in kernel frame j-1 at the trig values in ``ws``.
+
+    R = R_place Rz(q) and p = p_place + R_place z * slide: a revolute joint
+    mixes the first two columns of its placement, a prismatic one moves
+    the origin along the third.
+    """
+    c = ws[j, W_CT]
+    s = ws[j, W_ST]
     d = ws[j, W_DD]
-    a = links[j, L_A]
-    ca = links[j, L_CA]
-    sa = links[j, L_SA]
-    zero = frames[F_CONST, C_ZERO]
-    if links[j, L_CONV] == zero:
-        # standard: A = Rz(theta) Tz(d) Tx(a) Rx(alpha); axis z_{j-1} through
-        # K = O_{j-1} + d z_{j-1}; O_j = K + a x_j.
-        R = (ct, -st * ca, st * sa, st, ct * ca, -ct * sa, zero, sa, ca)
-        p = (a * ct, a * st, d)
-        u = (zero, sa, ca)
-        s = (a, zero, zero)
-        rK = (zero, zero, d)
-    else:
-        # modified (Craig): A = Rx(alpha) Tx(a) Rz(theta) Tz(d); axis z_j
-        # through K = O_j.
-        R = (ct, -st, zero, ca * st, ca * ct, -sa, sa * st, sa * ct, ca)
-        p = (a, -sa * d, ca * d)
-        u = (zero, zero, frames[F_CONST, C_ONE])
-        s = (zero, zero, zero)
-        rK = p
-    return R, p, u, s, rK
+    k = L_R
+    r0 = links[j, k]
+    r1 = links[j, k + 1]
+    r2 = links[j, k + 2]
+    r3 = links[j, k + 3]
+    r4 = links[j, k + 4]
+    r5 = links[j, k + 5]
+    r6 = links[j, k + 6]
+    r7 = links[j, k + 7]
+    r8 = links[j, k + 8]
+    R = (r0 * c + r1 * s, r1 * c - r0 * s, r2,
+         r3 * c + r4 * s, r4 * c - r3 * s, r5,
+         r6 * c + r7 * s, r7 * c - r6 * s, r8)
+    p = (links[j, L_P] + r2 * d, links[j, L_P + 1] + r5 * d,
+         links[j, L_P + 2] + r8 * d)
+    return R, p
 
 
 @njit(cache=True)
@@ -226,13 +220,14 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
     Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
 
     ``joint_trig(links, frames, q, ws)`` must have been called for the same q.
-    Cost: about 330 flops per joint, O(n).
+    Cost: about 250 flops per joint, O(n).  Every vector of link j is in
+    kernel frame j, whose z axis is joint j's axis through its origin.
 
     Parameters
     ----------
     links : (n, L_WIDTH) array
-        Per-joint DH, mass, centre-of-mass and inertia parameters (the
-        ``L_*`` columns).
+        Per-joint placement, mass, centre-of-mass and inertia parameters
+        (the ``L_*`` columns).
     frames : (F_ROWS, 12) array
         Base frame, tool frame, gravity and constants (the ``F_*`` rows).
     qd, v, qdd : (n,) arrays
@@ -268,51 +263,36 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
 
     # ---- forward recursion: base to tip ----
     for j in range(n):
-        R, p, u, s, rK = _link_geometry(links, frames, j, ws)
-        # acceleration of the point K, still in frame j-1 axes
-        t = _cross(al[0], al[1], al[2], rK[0], rK[1], rK[2])
-        aK = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        R, p = _link_geometry(links, frames, j, ws)
+        # acceleration of the new origin O_j, still in frame j-1 axes
+        t = _cross(al[0], al[1], al[2], p[0], p[1], p[2])
+        ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
         if velocity_on:
-            t = _cross(r[0], r[1], r[2], rK[0], rK[1], rK[2])
+            t = _cross(r[0], r[1], r[2], p[0], p[1], p[2])
             t = _cross(w[0], w[1], w[2], t[0], t[1], t[2])
-            aK = (aK[0] + t[0], aK[1] + t[1], aK[2] + t[2])
+            ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
         # rotate everything into frame j
-        aK = _rotT(R, aK[0], aK[1], aK[2])
+        ae = _rotT(R, ae[0], ae[1], ae[2])
         al = _rotT(R, al[0], al[1], al[2])
         revolute = _revolute(links, frames, j)
         if velocity_on:
             w = _rotT(R, w[0], w[1], w[2])
             r = _rotT(R, r[0], r[1], r[2])
             if revolute:
-                # alpha_j = R^T alpha_{j-1} + u qdd + (r_{j-1} x u) qd_j
-                t = _cross(r[0], r[1], r[2], u[0], u[1], u[2])
-                al = (al[0] + u[0] * qdd[j] + t[0] * qd[j],
-                      al[1] + u[1] * qdd[j] + t[1] * qd[j],
-                      al[2] + u[2] * qdd[j] + t[2] * qd[j])
-                w = (w[0] + u[0] * qd[j], w[1] + u[1] * qd[j],
-                     w[2] + u[2] * qd[j])
-                r = (r[0] + u[0] * v[j], r[1] + u[1] * v[j],
-                     r[2] + u[2] * v[j])
+                # alpha_j = R^T alpha_{j-1} + z qdd + (r_{j-1} x z) qd_j
+                al = (al[0] + r[1] * qd[j], al[1] - r[0] * qd[j],
+                      al[2] + qdd[j])
+                w = (w[0], w[1], w[2] + qd[j])
+                r = (r[0], r[1], r[2] + v[j])
+            else:
+                # the sliding joint: z qdd + Coriolis 2 w x z qd (v == qd)
+                ae = (ae[0] + r[1] * qd[j] + w[1] * v[j],
+                      ae[1] - r[0] * qd[j] - w[0] * v[j],
+                      ae[2] + qdd[j])
         elif revolute:
-            al = (al[0] + u[0] * qdd[j], al[1] + u[1] * qdd[j],
-                  al[2] + u[2] * qdd[j])
-        # acceleration of O_j: from K along s, with the joint's own terms
-        t = _cross(al[0], al[1], al[2], s[0], s[1], s[2])
-        ae = (aK[0] + t[0], aK[1] + t[1], aK[2] + t[2])
-        if velocity_on:
-            t = _cross(r[0], r[1], r[2], s[0], s[1], s[2])
-            t = _cross(w[0], w[1], w[2], t[0], t[1], t[2])
-            ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
-        if not revolute:
-            ae = (ae[0] + u[0] * qdd[j], ae[1] + u[1] * qdd[j],
-                  ae[2] + u[2] * qdd[j])
-            if velocity_on:
-                # Coriolis of the sliding joint: 2 w x u qd when v == qd
-                t = _cross(r[0], r[1], r[2], u[0], u[1], u[2])
-                t2 = _cross(w[0], w[1], w[2], u[0], u[1], u[2])
-                ae = (ae[0] + t[0] * qd[j] + t2[0] * v[j],
-                      ae[1] + t[1] * qd[j] + t2[1] * v[j],
-                      ae[2] + t[2] * qd[j] + t2[2] * v[j])
+            al = (al[0], al[1], al[2] + qdd[j])
+        else:
+            ae = (ae[0], ae[1], ae[2] + qdd[j])
         # acceleration of the centre of mass
         c0 = links[j, L_COM]
         c1 = links[j, L_COM + 1]
@@ -351,8 +331,6 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
             ws[j, W_R + k] = R[k]
         for k in range(3):
             ws[j, W_P + k] = p[k]
-            ws[j, W_U + k] = u[k]
-            ws[j, W_S + k] = s[k]
         if wrench_mode == WRENCH_BASE:
             Racc = _matmul(Racc, R)
 
@@ -385,17 +363,12 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         nm = (nm[0] + t[0] + ws[j, W_N], nm[1] + t[1] + ws[j, W_N + 1],
               nm[2] + t[2] + ws[j, W_N + 2])
         f = (f[0] + F0, f[1] + F1, f[2] + F2)
-        u0 = ws[j, W_U]
-        u1 = ws[j, W_U + 1]
-        u2 = ws[j, W_U + 2]
+        # the joint takes the moment about (revolute) or the force along
+        # (prismatic) its axis z
         if _revolute(links, frames, j):
-            # moment about the axis point K = O_j - s
-            t = _cross(ws[j, W_S], ws[j, W_S + 1], ws[j, W_S + 2],
-                       f[0], f[1], f[2])
-            tau[j] = (u0 * (nm[0] + t[0]) + u1 * (nm[1] + t[1])
-                      + u2 * (nm[2] + t[2]))
+            tau[j] = nm[2]
         else:
-            tau[j] = u0 * f[0] + u1 * f[1] + u2 * f[2]
+            tau[j] = f[2]
         if j > 0:
             R = (ws[j, W_R], ws[j, W_R + 1], ws[j, W_R + 2],
                  ws[j, W_R + 3], ws[j, W_R + 4], ws[j, W_R + 5],
@@ -554,23 +527,6 @@ def _sym_rotate(R, S):
 
 
 @njit(cache=True)
-def _joint_force(links, frames, j, ws, F0, F1, F2, N0, N1, N2):
-    """
-    Joint j's component of the wrench (F, N about O_j) in frame j.
-
-    The moment about the axis for a revolute joint, u . (N + s x F), the
-    force along it for a prismatic one, u . F (the recursion's last step).
-    """
-    u0 = ws[j, W_U]
-    u1 = ws[j, W_U + 1]
-    u2 = ws[j, W_U + 2]
-    if _revolute(links, frames, j):
-        t = _cross(ws[j, W_S], ws[j, W_S + 1], ws[j, W_S + 2], F0, F1, F2)
-        return u0 * (N0 + t[0]) + u1 * (N1 + t[1]) + u2 * (N2 + t[2])
-    return u0 * F0 + u1 * F1 + u2 * F2
-
-
-@njit(cache=True)
 def mass_matrix_crba(links, frames, q, ws, D):
     """
     D(q) by the composite-rigid-body algorithm (CRBA); O(n^2), small constant.
@@ -583,7 +539,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
     entries j > i of the column come from symmetry, D[j, i] = D[i, j],
     filled when column j is done.
 
-    Composite i is kept in frame i as its mass M, first moment
+    Composite i is kept in kernel frame i as its mass M, first moment
     h = sum m_k c_k (c_k: centre of mass of link k seen from O_i) and
     rotational inertia I about O_i, never divided by the mass, so massless
     links and composites need no care.  It is built from the tip: add link
@@ -595,17 +551,18 @@ def mass_matrix_crba(links, frames, q, ws, D):
     matrix), written with g = hr + M p / 2 as
     I' = R I R^T + 2 (g . p) 1 - (g p^T + p g^T) so it stays symmetric.
 
-    Unit rate of joint i: revolute, angular acceleration al = u about the
-    axis through K, so O_i accelerates by a = u x s; prismatic, al = 0
-    and a = u.  Newton-Euler about O_i (not the centre of mass) at zero
-    velocity: F = M a + al x h, N = I al + h x a.  D[i, i] is joint i's
-    component (``_joint_force``: u . (N + s x F), or u . F); for
-    j = i-1..0 the wrench is carried to frame j by the recursion's
-    backward step F <- R F, N <- R N + p x F and D[j, i] = D[i, j] is joint
-    j's component.  D is symmetric exactly.  Cost: about 200 flops per
-    joint plus 60 per pair j < i, against the n recursions of
-    ``mass_matrix``; the same D as those up to round-off (the tests check
-    10 n eps in float64 and 1e-40 at 50 digits).
+    Unit rate of joint i (axis z through O_i): revolute, angular
+    acceleration z with O_i at rest; prismatic, no rotation and O_i
+    accelerating by z.  Newton-Euler about O_i (not the centre of mass)
+    at zero velocity: F = M a + al x h, N = I al + h x a, that is
+    F = z x h, N = I z (revolute) or F = M z, N = h x z (prismatic).
+    D[i, i] is joint i's component (N_z, or F_z); for j = i-1..0 the
+    wrench is carried to frame j by the recursion's backward step
+    F <- R F, N <- R N + p x F and D[j, i] = D[i, j] is joint j's
+    component.  D is symmetric exactly.  Cost: about 170 flops per joint
+    plus 50 per pair j < i, against the n recursions of ``mass_matrix``;
+    the same D as those up to round-off (the tests check 10 n eps in
+    float64 and 1e-40 at 50 digits).
 
     Returns -1, or OVERFLOW when an entry is not finite (as ``mass_matrix``).
     """
@@ -614,13 +571,11 @@ def mass_matrix_crba(links, frames, q, ws, D):
     half = frames[F_CONST, C_HALF]
     joint_trig(links, frames, q, ws)
     for j in range(n):
-        R, p, u, s, rK = _link_geometry(links, frames, j, ws)
+        R, p = _link_geometry(links, frames, j, ws)
         for k in range(9):
             ws[j, W_R + k] = R[k]
         for k in range(3):
             ws[j, W_P + k] = p[k]
-            ws[j, W_U + k] = u[k]
-            ws[j, W_S + k] = s[k]
     M = zero
     h = (zero, zero, zero)
     Io = (zero, zero, zero, zero, zero, zero)
@@ -643,20 +598,15 @@ def mass_matrix_crba(links, frames, q, ws, D):
               Io[4] + half * (links[i, k + 5] + links[i, k + 7]) - mc1 * c2,
               Io[5] + half * (links[i, k + 2] + links[i, k + 6]) - mc0 * c2)
         # ---- wrench on the composite for a unit rate of joint i ----
-        u = (ws[i, W_U], ws[i, W_U + 1], ws[i, W_U + 2])
-        if _revolute(links, frames, i):
-            a = _cross(u[0], u[1], u[2], ws[i, W_S], ws[i, W_S + 1],
-                       ws[i, W_S + 2])
-            t = _cross(u[0], u[1], u[2], h[0], h[1], h[2])
-            F = (M * a[0] + t[0], M * a[1] + t[1], M * a[2] + t[2])
-            Iu = _sym_mul(Io, u[0], u[1], u[2])
-            t = _cross(h[0], h[1], h[2], a[0], a[1], a[2])
-            N = (Iu[0] + t[0], Iu[1] + t[1], Iu[2] + t[2])
+        revolute = _revolute(links, frames, i)
+        if revolute:
+            F = (-h[1], h[0], zero)
+            N = (Io[5], Io[4], Io[2])
+            D[i, i] = N[2]
         else:
-            F = (M * u[0], M * u[1], M * u[2])
-            N = _cross(h[0], h[1], h[2], u[0], u[1], u[2])
-        D[i, i] = _joint_force(links, frames, i, ws, F[0], F[1], F[2],
-                               N[0], N[1], N[2])
+            F = (zero, zero, M)
+            N = (h[1], -h[0], zero)
+            D[i, i] = F[2]
         # ---- carry it to the base, joint by joint ----
         for j in range(i - 1, -1, -1):
             R = (ws[j + 1, W_R], ws[j + 1, W_R + 1], ws[j + 1, W_R + 2],
@@ -667,8 +617,10 @@ def mass_matrix_crba(links, frames, q, ws, D):
             t = _cross(ws[j + 1, W_P], ws[j + 1, W_P + 1], ws[j + 1, W_P + 2],
                        F[0], F[1], F[2])
             N = (N[0] + t[0], N[1] + t[1], N[2] + t[2])
-            x = _joint_force(links, frames, j, ws, F[0], F[1], F[2],
-                             N[0], N[1], N[2])
+            if _revolute(links, frames, j):
+                x = N[2]
+            else:
+                x = F[2]
             D[j, i] = x
             D[i, j] = x
         # ---- the composite in frame i-1, about O_{i-1} ----
@@ -704,12 +656,13 @@ def _matrix_status(M):
 
 
 @njit(cache=True)
-def forward_kinematics(links, frames, q, ws, Ts):
+def _chain_poses(links, frames, q, ws, Ts, link_frames):
     """
-    Poses of frames 0..n and of the end effector in the base frame.
+    Walk the chain and store the poses of its frames in ``Ts``.
 
-    ``Ts`` is (n + 2, 12): rows 0..n the link frames, row n+1 the end
-    effector; each row R (9, row-major) then p (3).
+    Rows 1..n get kernel frames 1..n (or, with ``link_frames``, the link
+    frames of the model, B_j applied), row 0 frame 0, row n+1 the end
+    effector; all in the base frame, each row R (9, row-major) then p (3).
     """
     n = links.shape[0]
     joint_trig(links, frames, q, ws)
@@ -721,17 +674,39 @@ def forward_kinematics(links, frames, q, ws, Ts):
         Ts[0, 9 + k] = pw[k]
     for j in range(n + 1):
         if j < n:
-            R, p, u, s, rK = _link_geometry(links, frames, j, ws)
+            R, p = _link_geometry(links, frames, j, ws)
         else:
             R = _frame_rot(frames, F_TOOL)
             p = (frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11])
         t = _rot(Rw, p[0], p[1], p[2])
         pw = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
         Rw = _matmul(Rw, R)
+        Ro = Rw
+        po = pw
+        if link_frames and j < n:
+            k = L_BODY
+            RB = (links[j, k], links[j, k + 1], links[j, k + 2],
+                  links[j, k + 3], links[j, k + 4], links[j, k + 5],
+                  links[j, k + 6], links[j, k + 7], links[j, k + 8])
+            t = _rot(Rw, links[j, k + 9], links[j, k + 10], links[j, k + 11])
+            po = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
+            Ro = _matmul(Rw, RB)
         for k in range(9):
-            Ts[j + 1, k] = Rw[k]
+            Ts[j + 1, k] = Ro[k]
         for k in range(3):
-            Ts[j + 1, 9 + k] = pw[k]
+            Ts[j + 1, 9 + k] = po[k]
+
+
+@njit(cache=True)
+def forward_kinematics(links, frames, q, ws, Ts):
+    """
+    Poses of frame 0, the link frames 1..n and the end effector.
+
+    ``Ts`` is (n + 2, 12), in the base frame: row 0 frame 0, rows 1..n the
+    model's link frames (where its inertial parameters are given), row
+    n+1 the end effector; each row R (9, row-major) then p (3).
+    """
+    _chain_poses(links, frames, q, ws, Ts, True)
 
 
 @njit(cache=True)
@@ -740,20 +715,15 @@ def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
     Geometric Jacobian of the end-effector origin, rows [v; w].
 
     Base-frame axes, or end-effector axes when ``in_ee_axes``.  Cost O(n).
+    Joint j moves about z of kernel frame j, through its origin.
     """
     n = links.shape[0]
-    forward_kinematics(links, frames, q, ws, Ts)
+    _chain_poses(links, frames, q, ws, Ts, False)
     pe = (Ts[n + 1, 9], Ts[n + 1, 10], Ts[n + 1, 11])
     zero = frames[F_CONST, C_ZERO]
     for j in range(n):
-        # the axis of joint j and a point K on it, in base axes
-        if links[j, L_CONV] == zero:
-            row = j           # standard: z_{j-1} through O_{j-1} + d z_{j-1}
-        else:
-            row = j + 1       # modified: z_j through O_j
-        Rr = (Ts[row, 0], Ts[row, 1], Ts[row, 2], Ts[row, 3], Ts[row, 4],
-              Ts[row, 5], Ts[row, 6], Ts[row, 7], Ts[row, 8])
-        z = (Rr[2], Rr[5], Rr[8])
+        row = j + 1
+        z = (Ts[row, 2], Ts[row, 5], Ts[row, 8])
         if _revolute(links, frames, j):
             rel = (pe[0] - Ts[row, 9], pe[1] - Ts[row, 10],
                    pe[2] - Ts[row, 11])

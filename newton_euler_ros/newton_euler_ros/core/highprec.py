@@ -18,10 +18,12 @@ The same Newton-Euler recursion in high precision (mpmath), as a reference.
 The source of ``_kernels`` is executed a second time with ``njit``
 replaced by the identity and ``math`` by mpmath, over numpy object arrays
 of ``mpf`` numbers: one implementation of the recursion, evaluated at 50
-significant digits (by default) from the exact float64 inputs.  The DH
-angles' cosines and sines, the base rotation applied to gravity, and all
-arithmetic are done at that precision; the model's float64 numbers (and
-the float64 base/tool matrices) are taken as exact.
+significant digits (by default) from the exact float64 inputs.  The
+model is compiled into kernel frames at that precision too (the same
+``model.compile_arrays``): the cosines and sines of DH and URDF angles,
+the joint-axis rotations, the re-expressed inertial parameters and the
+base rotation applied to gravity; the model's float64 numbers (and the
+float64 base/tool matrices) are taken as exact.
 
 Slow (milliseconds per call): for measuring the error of the float64 and
 float32 paths, never for control.
@@ -34,6 +36,7 @@ import numpy as np
 
 from . import _kernels as K
 from .dynamics import _bad_method, MASS_MATRIX_METHODS
+from .model import compile_arrays
 
 _SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
                        '_kernels.py')
@@ -71,28 +74,27 @@ def _mp_array(x):
     return np.array(flat, dtype=object).reshape(np.shape(x))
 
 
+class _MpNumbers(_MpMath):
+    """``compile_arrays``'s number type: mpf from exact float64 values."""
+
+    @staticmethod
+    def num(x):
+        """Return x (a float64, or already an mpf) as an mpf."""
+        return x if isinstance(x, mpmath.mpf) else mpmath.mpf(float(x))
+
+
 class HighPrecisionModel:
-    """A model's kernel arrays converted to mpmath at ``dps`` digits."""
+    """A model's kernel arrays compiled in mpmath at ``dps`` digits."""
 
     def __init__(self, model, dps=50):
         self.model = model
         self.dps = dps
         with mpmath.workdps(dps):
-            links = _mp_array(model.links_array)
-            for j in range(model.n):
-                alpha = mpmath.mpf(float(model.alpha[j]))
-                links[j, K.L_CA] = mpmath.cos(alpha)
-                links[j, K.L_SA] = mpmath.sin(alpha)
-                theta = mpmath.mpf(float(model.theta[j]))
-                links[j, K.L_CT0] = mpmath.cos(theta)
-                links[j, K.L_ST0] = mpmath.sin(theta)
-            frames = _mp_array(model.frames_array)
-            R = _mp_array(model.base[:3, :3])
-            g = _mp_array(model.gravity)
-            for i in range(3):
-                frames[K.F_GRAV, i] = sum(R[k, i] * g[k] for k in range(3))
-        self.links = links
-        self.frames = frames
+            links, frames = compile_arrays(model, _MpNumbers)
+            self.links = np.array(
+                [list(row) for row in links],
+                dtype=object).reshape(model.n, K.L_WIDTH)
+            self.frames = np.array(frames, dtype=object)
 
     def _vec(self, x, size):
         if x is None:
