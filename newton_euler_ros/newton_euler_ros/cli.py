@@ -13,17 +13,19 @@
 # limitations under the License.
 
 """
-``newton-euler``: inverse dynamics of a DH robot from the command line.
+``newton-euler``: inverse dynamics of a robot from the command line.
 
     newton-euler dynamics ROBOT --q ... [--qd ...] [--qdd ...]
                                 [--wrench fx fy fz nx ny nz]
                                 [--wrench-frame base|end_effector] [--json]
     newton-euler dynamics ROBOT --states STATES.json
     newton-euler check ROBOT
+    newton-euler urdf ROBOT [-o FILE]
     newton-euler robots
 
-ROBOT is a robot YAML file or the name of a bundled robot.  Every error is
-one line on stderr and a non-zero exit status.
+ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
+(``.urdf``, with ``--base LINK --tip LINK`` to choose the chain).  Every
+error is one line on stderr and a non-zero exit status.
 """
 import argparse
 import json
@@ -115,6 +117,18 @@ def _matrix_lines(title, names, M, col_names=None):
     return lines
 
 
+def _source(model):
+    if model.is_dh:
+        return f'{model.convention} DH'
+    report = model.info.get('urdf', {})
+    return (f'URDF chain {report.get("base", "?")} -> '
+            f'{report.get("tip", "?")}')
+
+
+def _load(args):
+    return inspect_robot(args.robot, base=args.base, tip=args.tip)
+
+
 def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
     """Return a human-readable, multi-line report of one evaluation."""
     names = result['joint_names']
@@ -123,7 +137,7 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
     g = np.array(result['gravity'])
     J = np.array(result['jacobian'])
     jtf = J.T @ wrench if wrench is not None else np.zeros(len(names))
-    lines = [f'{model.name}: {model.n} joints, {model.convention} DH, '
+    lines = [f'{model.name}: {model.n} joints, {_source(model)}, '
              f'gravity {model.gravity.tolist()} m/s^2 (base frame)']
     if wrench is not None:
         lines.append(f'end-effector wrench (exerted by the robot, '
@@ -154,7 +168,7 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
 
 
 def cmd_dynamics(args):
-    model, found, _ = inspect_robot(args.robot)
+    model, found, _ = _load(args)
     for message in found:
         print(f'warning: {message}', file=sys.stderr)
     n = model.n
@@ -188,13 +202,25 @@ def cmd_dynamics(args):
 
 
 def cmd_check(args):
-    model, found, path = inspect_robot(args.robot)
+    model, found, path = _load(args)
     types = ''.join('R' if t == 'revolute' else 'P'
                     for t in model.joint_types)
     print(f'{path}: OK')
     print(f'  name: {model.name}')
-    print(f'  joints: {model.n} ({types}), {model.convention} DH')
+    print(f'  joints: {model.n} ({types}), {_source(model)}')
     print(f'  joint names: {", ".join(model.joint_names)}')
+    report = model.info.get('urdf')
+    if report:
+        chain = [report['base']]
+        for jname, link in zip(report['chain'], report['chain_links']):
+            chain.append(f'-[{jname}]-> {link}')
+        print(f'  chain: {" ".join(chain)}')
+        print(f'  merged fixed joints: '
+              f'{", ".join(report["merged_fixed"]) or "none"}')
+        print(f'  lumped off-chain subtrees (at zero position): '
+              f'{", ".join(report["lumped"]) or "none"}')
+        print(f'  continuous joints: '
+              f'{", ".join(report["continuous"]) or "none"}')
     print(f'  total mass: {model.total_mass:.6g} kg')
     print(f'  gravity: {model.gravity.tolist()} m/s^2')
     print(f'  warnings: {len(found)}')
@@ -237,6 +263,33 @@ def cmd_simulate(args):
     return 0
 
 
+def cmd_urdf(args):
+    from .core.urdf import model_to_urdf
+    model, found, _ = _load(args)
+    for message in found:
+        print(f'warning: {message}', file=sys.stderr)
+    text = model_to_urdf(model)
+    if args.output:
+        try:
+            with open(args.output, 'w', encoding='utf-8') as fh:
+                fh.write(text)
+        except OSError as exc:
+            raise CliError(f'{args.output}: cannot write: '
+                           f'{exc.strerror}') from None
+    else:
+        sys.stdout.write(text)
+    return 0
+
+
+def _chain_options(parser):
+    parser.add_argument('--base', metavar='LINK',
+                        help='URDF only: first link of the chain (default: '
+                             'the root link)')
+    parser.add_argument('--tip', metavar='LINK',
+                        help='URDF only: last link of the chain, the end '
+                             'effector (default: the single leaf)')
+
+
 def cmd_robots(_args):
     for name in bundled_robots():
         print(name)
@@ -252,7 +305,9 @@ def build_parser():
     parser = _Parser(prog='newton-euler', description=__doc__.strip().split('\n')[0])
     sub = parser.add_subparsers(dest='command', parser_class=_Parser)
     dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
-    dyn.add_argument('robot', help='robot YAML file or bundled robot name')
+    dyn.add_argument('robot', help='robot YAML or URDF file, or bundled '
+                                   'robot name')
+    _chain_options(dyn)
     dyn.add_argument('--q', nargs='+', metavar='Q',
                      help='joint positions (rad or m)')
     dyn.add_argument('--qd', nargs='+', metavar='QD',
@@ -274,7 +329,15 @@ def build_parser():
     dyn.set_defaults(func=cmd_dynamics)
     chk = sub.add_parser('check', help='validate a robot file')
     chk.add_argument('robot')
+    _chain_options(chk)
     chk.set_defaults(func=cmd_check)
+    urdf = sub.add_parser('urdf', help='write a robot as URDF (inertials, '
+                                       'limits, a fixed tool0 link)')
+    urdf.add_argument('robot')
+    urdf.add_argument('-o', '--output', metavar='FILE',
+                      help='write to FILE instead of standard output')
+    _chain_options(urdf)
+    urdf.set_defaults(func=cmd_urdf)
     sim = sub.add_parser('simulate', help='simulate a scene offline')
     sim.add_argument('scene', help='scene YAML file or bundled scene name')
     sim.add_argument('--duration', type=float, metavar='T',

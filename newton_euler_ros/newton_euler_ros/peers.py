@@ -54,6 +54,7 @@ Robotics Toolbox for Python (``import roboticstoolbox``)
     (revolute) or ``d`` (prismatic) becomes the toolbox's joint ``offset``.
 """
 import math
+import os
 
 import numpy as np
 
@@ -177,3 +178,77 @@ def versions():
         except Exception as exc:  # ImportError, or a broken binary wheel
             out[label] = f'unavailable: {type(exc).__name__}: {exc}'
     return out
+
+
+def example_robot_urdf(relative):
+    """
+    Path of a URDF shipped by the ``example-robot-data`` package.
+
+    ``relative`` is below its ``robots`` folder, e.g.
+    ``'ur_description/urdf/ur5_robot.urdf'``.  Raises ImportError when the
+    package (installed by ``make peers``) is missing.
+    """
+    from importlib import metadata
+    try:
+        dist = metadata.distribution('example-robot-data')
+    except metadata.PackageNotFoundError:
+        raise ImportError('example-robot-data is not installed '
+                          '(make peers)') from None
+    root = dist.locate_file('cmeel.prefix/share/example-robot-data/robots')
+    return os.path.join(str(root), relative)
+
+
+class PinocchioUrdf:
+    """
+    Pinocchio's own reading of a URDF, reduced to our chain.
+
+    ``pin.buildModelFromUrdf`` (fixed base), then ``pin.buildReducedModel``
+    locks every joint that is not on the chain from ``base`` to ``tip`` at
+    its neutral position: the reference for "off-chain subtrees lumped at
+    zero".  Continuous joints take (cos q, sin q) in Pinocchio's
+    configuration; :meth:`config` converts.  The base must be the URDF's
+    root (Pinocchio's universe), so that both use the same axes.
+    """
+
+    def __init__(self, path, chain_joints, tip):
+        import pinocchio as pin
+        self.pin = pin
+        full = pin.buildModelFromUrdf(path)
+        lock = [i for i in range(1, full.njoints)
+                if full.names[i] not in chain_joints]
+        self.model = (pin.buildReducedModel(full, lock, pin.neutral(full))
+                      if lock else full)
+        self.data = self.model.createData()
+        names = list(self.model.names)[1:]
+        if names != list(chain_joints):
+            raise ValueError(f'Pinocchio chain {names} is not {chain_joints}')
+        self.frame = self.model.getFrameId(tip, pin.FrameType.BODY)
+
+    def config(self, q):
+        """Pinocchio's configuration vector of our joint positions."""
+        out = self.pin.neutral(self.model)
+        for j in range(1, self.model.njoints):
+            joint = self.model.joints[j]
+            if joint.nq == 2:       # continuous: cos, sin
+                out[joint.idx_q] = math.cos(q[j - 1])
+                out[joint.idx_q + 1] = math.sin(q[j - 1])
+            else:
+                out[joint.idx_q] = q[j - 1]
+        return out
+
+    def terms(self, q, qd, qdd, wrench):
+        """tau, D, C, g, J (tip, world axes) and tau + J^T F_e."""
+        pin = self.pin
+        m, d = self.model, self.data
+        x = self.config(q)
+        tau = pin.rnea(m, d, x, qd, qdd).copy()
+        D = pin.crba(m, d, x)
+        D = np.triu(D) + np.triu(D, 1).T
+        C = pin.computeCoriolisMatrix(m, d, x, qd).copy()
+        g = pin.computeGeneralizedGravity(m, d, x).copy()
+        pin.computeJointJacobians(m, d, x)
+        pin.updateFramePlacements(m, d)
+        J = pin.getFrameJacobian(m, d, self.frame,
+                                 pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+        return {'tau': tau, 'D': D, 'C': C, 'g': g, 'J': J.copy(),
+                'tau_wrench': tau + J.T @ wrench}

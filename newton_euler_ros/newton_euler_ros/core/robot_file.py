@@ -308,22 +308,44 @@ def robot_from_dict(data, origin='<robot>'):
     return model, found
 
 
-def inspect_robot(name_or_path):
-    """Load and validate a robot file; return (model, warnings, path)."""
+def is_urdf(name_or_path):
+    """Return True for a path that names a URDF file (``.urdf``)."""
+    return str(name_or_path).lower().endswith('.urdf')
+
+
+def inspect_robot(name_or_path, base=None, tip=None):
+    """
+    Load and validate a robot; return (model, warnings, path).
+
+    A ``.urdf`` path is read by :func:`~newton_euler_ros.core.urdf.inspect_urdf`
+    with its ``base`` and ``tip`` links (what it made of the tree is in
+    ``model.info['urdf']``); anything else is a robot YAML file or a
+    bundled name, for which ``base`` and ``tip`` must be None.
+    """
+    if is_urdf(name_or_path):
+        from .urdf import inspect_urdf
+        model, found, _ = inspect_urdf(name_or_path, base=base, tip=tip)
+        return model, found, str(name_or_path)
+    if base is not None or tip is not None:
+        raise RobotFileError(f'{name_or_path}: base and tip links apply to '
+                             f'URDF robots (.urdf files) only')
     path = resolve_robot_path(name_or_path)
     data = read_yaml(path)
     model, found = robot_from_dict(data, os.path.basename(path))
     return model, found, path
 
 
-def load_robot(name_or_path):
+def load_robot(name_or_path, base=None, tip=None):
     """
-    Load a robot file (a path, or a bundled name such as ``'puma560'``).
+    Load a robot: a YAML file, a bundled name (``'puma560'``) or a URDF.
 
-    Warnings (e.g. inertias that break the triangle inequality) are issued
-    as :class:`RobotFileWarning`; errors raise :class:`RobotFileError`.
+    A ``.urdf`` file gives the chain from ``base`` to ``tip`` (defaults:
+    the root link, and the single leaf below it); see
+    :mod:`newton_euler_ros.core.urdf`.  Warnings (e.g. inertias that break
+    the triangle inequality) are issued as :class:`RobotFileWarning`;
+    errors raise :class:`RobotFileError`.
     """
-    model, found, _ = inspect_robot(name_or_path)
+    model, found, _ = inspect_robot(name_or_path, base=base, tip=tip)
     for message in found:
         warnings.warn(message, RobotFileWarning, stacklevel=2)
     return model

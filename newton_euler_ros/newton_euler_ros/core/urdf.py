@@ -1,0 +1,729 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Robots from URDF: the chain from a base link to a tip link as a model.
+
+What a URDF model means here (see the README, "Robots from URDF"):
+
+- The chain runs from ``base`` (default: the URDF's root link) to ``tip``
+  (default: the single leaf below the base).  Its ``revolute``,
+  ``continuous`` and ``prismatic`` joints are the model's joints, in
+  chain order; a ``floating`` or ``planar`` joint on the chain is an
+  error.
+- ``fixed`` joints on the chain are merged: their origins are composed
+  into the next moving joint's placement (or into the tool, after the
+  last one), and the links they carry are combined with the moving link
+  by the parallel-axis theorem.
+- Off-chain subtrees (gripper fingers, a second arm, a head) are lumped
+  rigidly into the chain link they hang from, at their joints' zero
+  position (a ``mimic`` joint at its offset), with one warning naming
+  them: their own motion is not modelled.
+- ``<inertial>`` with its ``<origin xyz rpy>``: the inertia is rotated into
+  the link frame (I_link = R I R^T, the centre of mass at xyz).  A link
+  without ``<inertial>`` is massless (one warning lists them).
+- The end effector is the tip link's frame; gravity is [0, 0, -9.81] in
+  the base link's axes unless given.
+
+Parsing.  URDF text arrives from the network (the ``robot_description``
+topic), so it is parsed with ``defusedxml``: no DTDs, no entity
+declarations (so no entity expansion bombs), no external entities or
+network access; the text is capped at :data:`MAX_BYTES` and the document
+at :data:`MAX_ELEMENTS` links plus joints.  Meshes and visuals are never
+read.  Every error is a :class:`~newton_euler_ros.core.errors.RobotFileError`
+naming the source (the file, or ``robot_description``), the element and
+the attribute.
+"""
+import math
+import os
+import xml.etree.ElementTree as ET  # noqa: N817 (only for ParseError)
+
+import defusedxml
+import defusedxml.ElementTree as DET
+import numpy as np
+
+from .errors import RobotFileError
+from .model import make_chain, PRISMATIC, REVOLUTE, rpy_matrix
+
+MAX_BYTES = 16 * 1024 * 1024
+MAX_ELEMENTS = 20000
+MAX_NAME = 200
+MOVING = {'revolute': REVOLUTE, 'continuous': REVOLUTE,
+          'prismatic': PRISMATIC}
+JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'fixed', 'floating',
+               'planar')
+
+
+def _short(text, limit=MAX_NAME):
+    text = str(text)
+    return text if len(text) <= limit else text[:limit] + '...'
+
+
+class _Source:
+    """The origin of a URDF (for messages) and its parse tree."""
+
+    def __init__(self, label):
+        self.label = label
+
+    def error(self, where, message):
+        return RobotFileError(f'{self.label}: {where}: {message}')
+
+
+def read_urdf_text(text_or_path, label=None):
+    """
+    Return (text, label) for URDF given as XML text or as a file path.
+
+    Text is recognised by its first non-blank character, ``<``.
+    """
+    if isinstance(text_or_path, bytes):
+        text_or_path = _decode(text_or_path, label or 'robot_description')
+    text = str(text_or_path)
+    if text.lstrip().startswith('<'):
+        label = label or 'robot_description'
+        if len(text) > MAX_BYTES:
+            raise RobotFileError(
+                f'{label}: {len(text)} characters, more than the '
+                f'{MAX_BYTES} accepted')
+        return text, label
+    path = text
+    label = label or os.path.basename(path)
+    if os.path.isdir(path):
+        raise RobotFileError(f'{path}: is a directory, not a URDF file')
+    try:
+        size = os.path.getsize(path)
+        if size > MAX_BYTES:
+            raise RobotFileError(f'{path}: {size} bytes, more than the '
+                                 f'{MAX_BYTES} accepted for a URDF file')
+        with open(path, 'rb') as fh:
+            data = fh.read(MAX_BYTES + 1)
+    except OSError as exc:
+        raise RobotFileError(f'{path}: cannot read: {exc.strerror}') from None
+    if not data.strip():
+        raise RobotFileError(f'{label}: the file is empty')
+    return _decode(data, label), label
+
+
+def _decode(data, label):
+    try:
+        return data.decode('utf-8')
+    except UnicodeDecodeError as exc:
+        raise RobotFileError(f'{label}: not UTF-8 text (byte {exc.start}); '
+                             f'is it a URDF file?') from None
+
+
+def _parse(text, src):
+    if not text.strip():
+        raise RobotFileError(f'{src.label}: the URDF is empty')
+    try:
+        root = DET.fromstring(text, forbid_dtd=True, forbid_entities=True,
+                              forbid_external=True)
+    except defusedxml.DefusedXmlException as exc:
+        raise RobotFileError(f'{src.label}: refused: {exc} (DTDs and '
+                             f'entities are not accepted in URDF)') from None
+    except ET.ParseError as exc:
+        line, col = getattr(exc, 'position', (0, 0))
+        raise RobotFileError(f'{src.label}: not well-formed XML (line '
+                             f'{line}, column {col + 1})') from None
+    if root.tag != 'robot':
+        if root.tag.startswith('{') and 'xacro' in root.tag:
+            raise RobotFileError(f'{src.label}: a xacro file: expand it '
+                                 f'with xacro first')
+        raise RobotFileError(f'{src.label}: the root element is '
+                             f'<{_short(root.tag)}>, not <robot>')
+    for el in root.iter():
+        if isinstance(el.tag, str) and el.tag.startswith('{') \
+                and 'xacro' in el.tag:
+            raise RobotFileError(
+                f'{src.label}: contains xacro elements '
+                f'(<{_short(el.tag)}>): expand it with xacro first')
+    return root
+
+
+def _numbers(el, attr, count, where, src, default=None):
+    """Parse ``count`` space-separated finite numbers of an attribute."""
+    raw = el.get(attr) if el is not None else None
+    if raw is None:
+        if default is None:
+            raise src.error(where, f'missing attribute {attr!r}')
+        return list(default)
+    parts = raw.split()
+    if len(parts) != count:
+        raise src.error(f'{where} {attr}', f'must be {count} number'
+                        f'{"s" if count > 1 else ""}, got {_short(raw)!r}')
+    out = []
+    for part in parts:
+        try:
+            x = float(part)
+        except ValueError:
+            raise src.error(f'{where} {attr}', f'not a number: '
+                            f'{_short(part)!r}') from None
+        if not math.isfinite(x):
+            raise src.error(f'{where} {attr}', f'must be finite, got {part}')
+        out.append(x)
+    return out
+
+
+def _origin(el, where, src):
+    """(xyz, rpy) of an optional <origin> child."""
+    o = el.find('origin')
+    w = f'{where}<origin>'
+    xyz = _numbers(o, 'xyz', 3, w, src, (0.0, 0.0, 0.0))
+    rpy = _numbers(o, 'rpy', 3, w, src, (0.0, 0.0, 0.0))
+    return xyz, rpy
+
+
+def _origin_ops(xyz, rpy):
+    ops = []
+    if any(xyz):
+        ops.append(('xyz',) + tuple(xyz))
+    if any(rpy):
+        ops.append(('rpy',) + tuple(rpy))
+    return ops
+
+
+def _transform(xyz, rpy):
+    T = np.eye(4)
+    T[:3, :3] = rpy_matrix(*rpy)
+    T[:3, 3] = xyz
+    return T
+
+
+def _axis_motion(kind, axis, q):
+    """4x4 of a joint's own motion by q (a locked off-chain joint)."""
+    T = np.eye(4)
+    if q == 0.0:
+        return T
+    if kind in ('revolute', 'continuous'):
+        k = np.asarray(axis)
+        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
+                      [-k[1], k[0], 0.0]])
+        T[:3, :3] = np.eye(3) + math.sin(q) * K + (1 - math.cos(q)) * K @ K
+    elif kind == 'prismatic':
+        T[:3, 3] = np.asarray(axis) * q
+    return T
+
+
+class _Link:
+    def __init__(self, name):
+        self.name = name
+        self.mass = 0.0
+        self.com = np.zeros(3)
+        self.inertia = np.zeros((3, 3))
+        self.has_inertial = False
+        self.parent_joint = None
+        self.child_joints = []
+
+
+class _Joint:
+    def __init__(self, name, kind, parent, child):
+        self.name = name
+        self.kind = kind
+        self.parent = parent
+        self.child = child
+        self.xyz = (0.0, 0.0, 0.0)
+        self.rpy = (0.0, 0.0, 0.0)
+        self.axis = np.array([1.0, 0.0, 0.0])
+        self.limits = {}
+        self.mimic = None
+
+    @property
+    def origin(self):
+        return _transform(self.xyz, self.rpy)
+
+
+def _name(el, what, src, index):
+    name = el.get('name')
+    if name is None or not name.strip():
+        raise src.error(f'<{what}> #{index + 1}', "missing attribute 'name'")
+    if len(name) > MAX_NAME or any(ord(c) < 32 for c in name):
+        raise src.error(f'<{what}> #{index + 1} name', 'must be at most '
+                        f'{MAX_NAME} printable characters, got '
+                        f'{_short(name)!r}')
+    return name
+
+
+def _read_inertial(link, el, src):
+    where = f'link {link.name!r} <inertial>'
+    inertial = el.find('inertial')
+    if inertial is None:
+        return
+    link.has_inertial = True
+    xyz, rpy = _origin(inertial, where, src)
+    mass_el = inertial.find('mass')
+    if mass_el is None:
+        raise src.error(where, 'missing <mass>')
+    mass = _numbers(mass_el, 'value', 1, f'{where}<mass>', src)[0]
+    if mass < 0.0:
+        raise src.error(f'{where}<mass> value', f'must be >= 0, got {mass}')
+    in_el = inertial.find('inertia')
+    if in_el is None:
+        raise src.error(where, 'missing <inertia>')
+    vals = {}
+    for key in ('ixx', 'ixy', 'ixz', 'iyy', 'iyz', 'izz'):
+        vals[key] = _numbers(in_el, key, 1, f'{where}<inertia>', src)[0]
+    inertia = np.array([[vals['ixx'], vals['ixy'], vals['ixz']],
+                        [vals['ixy'], vals['iyy'], vals['iyz']],
+                        [vals['ixz'], vals['iyz'], vals['izz']]])
+    eig = np.linalg.eigvalsh(inertia)
+    scale = max(abs(eig).max(), 1e-300)
+    if eig[0] < -1e-9 * scale:
+        raise src.error(f'{where}<inertia>', 'not positive semi-definite '
+                        f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
+                        f'{eig[2]:.6g})')
+    R = rpy_matrix(*rpy)
+    link.mass = mass
+    link.com = np.array(xyz)
+    link.inertia = R @ inertia @ R.T
+    link.eig = eig
+
+
+def _read_joint(el, index, src, links):
+    name = _name(el, 'joint', src, index)
+    where = f'joint {name!r}'
+    kind = el.get('type')
+    if kind not in JOINT_TYPES:
+        raise src.error(f'{where} type', f'must be one of '
+                        f'{", ".join(JOINT_TYPES)}, got {_short(kind)!r}')
+    ends = []
+    for tag in ('parent', 'child'):
+        e = el.find(tag)
+        link = e.get('link') if e is not None else None
+        if link is None:
+            raise src.error(where, f'missing <{tag} link=...>')
+        if link not in links:
+            raise src.error(f'{where} <{tag}> link', f'no link named '
+                            f'{_short(link)!r}')
+        ends.append(link)
+    if ends[0] == ends[1]:
+        raise src.error(where, f'parent and child are the same link '
+                        f'{ends[0]!r}')
+    joint = _Joint(name, kind, ends[0], ends[1])
+    joint.xyz, joint.rpy = _origin(el, f'{where} ', src)
+    if kind in ('revolute', 'continuous', 'prismatic', 'planar'):
+        axis = np.array(_numbers(el.find('axis'), 'xyz', 3,
+                                 f'{where} <axis>', src, (1.0, 0.0, 0.0)))
+        norm = float(np.sqrt(axis @ axis))
+        if not norm > 0.0:
+            raise src.error(f'{where} <axis> xyz', 'must be a nonzero '
+                            'vector, got 0 0 0')
+        joint.axis = axis / norm
+    lim = el.find('limit')
+    if lim is not None and kind in ('revolute', 'continuous', 'prismatic'):
+        w = f'{where} <limit>'
+        out = {}
+        keys = ('effort', 'velocity') if kind == 'continuous' else (
+            'lower', 'upper', 'effort', 'velocity')
+        for key in keys:
+            if lim.get(key) is not None:
+                out[key] = _numbers(lim, key, 1, w, src)[0]
+        if 'lower' in out and 'upper' in out and out['lower'] > out['upper']:
+            raise src.error(f'{w} lower', f'{out["lower"]} is above upper '
+                            f'{out["upper"]}')
+        joint.limits = out
+    mimic = el.find('mimic')
+    if mimic is not None:
+        w = f'{where} <mimic>'
+        other = mimic.get('joint')
+        if other is None:
+            raise src.error(w, "missing attribute 'joint'")
+        mult = _numbers(mimic, 'multiplier', 1, w, src, (1.0,))[0]
+        off = _numbers(mimic, 'offset', 1, w, src, (0.0,))[0]
+        joint.mimic = (other, mult, off)
+    return joint
+
+
+def parse_urdf(text, label='robot_description'):
+    """Parse and check URDF text; return (name, links, joints) dicts."""
+    src = _Source(label)
+    root = _parse(text, src)
+    name = root.get('name') or 'robot'
+    link_els = root.findall('link')
+    joint_els = root.findall('joint')
+    if len(link_els) + len(joint_els) > MAX_ELEMENTS:
+        raise RobotFileError(f'{label}: {len(link_els)} links and '
+                             f'{len(joint_els)} joints, more than the '
+                             f'{MAX_ELEMENTS} accepted')
+    if not link_els:
+        raise RobotFileError(f'{label}: <robot> has no <link>')
+    links = {}
+    for i, el in enumerate(link_els):
+        lname = _name(el, 'link', src, i)
+        if lname in links:
+            raise src.error(f'link {lname!r}', 'the name is used twice')
+        link = links[lname] = _Link(lname)
+        _read_inertial(link, el, src)
+    joints = {}
+    for i, el in enumerate(joint_els):
+        joint = _read_joint(el, i, src, links)
+        if joint.name in joints:
+            raise src.error(f'joint {joint.name!r}', 'the name is used twice')
+        child = links[joint.child]
+        if child.parent_joint is not None:
+            raise src.error(f'joint {joint.name!r} <child> link',
+                            f'{joint.child!r} already has the parent joint '
+                            f'{child.parent_joint!r}')
+        child.parent_joint = joint.name
+        links[joint.parent].child_joints.append(joint.name)
+        joints[joint.name] = joint
+    for joint in joints.values():
+        if joint.mimic and joint.mimic[0] not in joints:
+            raise src.error(f'joint {joint.name!r} <mimic> joint',
+                            f'no joint named {_short(joint.mimic[0])!r}')
+    roots = [n for n, lk in links.items() if lk.parent_joint is None]
+    if not roots:
+        raise RobotFileError(f'{label}: the links form a cycle (every link '
+                             f'has a parent joint)')
+    if len(roots) > 1:
+        raise RobotFileError(f'{label}: more than one root link (links '
+                             f'without a parent joint): '
+                             f'{_short(", ".join(sorted(roots)), 400)}')
+    # every link must hang from the root: the others sit on a cycle
+    seen = set()
+    stack = [roots[0]]
+    while stack:
+        lname = stack.pop()
+        seen.add(lname)
+        stack.extend(joints[j].child for j in links[lname].child_joints)
+    if len(seen) != len(links):
+        cyc = sorted(set(links) - seen)
+        raise RobotFileError(f'{label}: links on a cycle: '
+                             f'{_short(", ".join(cyc), 400)}')
+    return name, roots[0], links, joints
+
+
+def _path(links, joints, base, tip):
+    """Joint names from base down to tip, or None if base is no ancestor."""
+    path = []
+    lname = tip
+    while lname != base:
+        jname = links[lname].parent_joint
+        if jname is None:
+            return None
+        path.append(jname)
+        lname = joints[jname].parent
+    return path[::-1]
+
+
+def _leaves_below(links, joints, base):
+    out = []
+    stack = [base]
+    while stack:
+        lname = stack.pop()
+        kids = links[lname].child_joints
+        if not kids:
+            out.append(lname)
+        stack.extend(joints[j].child for j in kids)
+    return sorted(out)
+
+
+def _lumped(links, joints, start, stop_joints, pose=np.eye(4)):
+    """
+    Every link rigidly attached to ``start``, with its pose in start's frame.
+
+    Follows every joint except those in ``stop_joints`` (the chain's next
+    moving joint); off-chain moving joints are taken at zero (mimic joints
+    at their offset).  Returns [(link name, 4x4 pose, via joint or None)].
+    """
+    out = [(start, pose, None)]
+    stack = [(start, pose)]
+    while stack:
+        lname, T = stack.pop()
+        for jname in links[lname].child_joints:
+            if jname in stop_joints:
+                continue
+            joint = joints[jname]
+            q = joint.mimic[2] if joint.mimic else 0.0
+            Tc = T @ joint.origin @ _axis_motion(joint.kind, joint.axis, q)
+            out.append((joint.child, Tc, jname))
+            stack.append((joint.child, Tc))
+    return out
+
+
+def _combine(parts, links):
+    """Mass, centre of mass and inertia (about it) of rigidly joined links."""
+    mass = 0.0
+    first = np.zeros(3)
+    for lname, T, _ in parts:
+        lk = links[lname]
+        mass += lk.mass
+        first += lk.mass * (T[:3, :3] @ lk.com + T[:3, 3])
+    com = first / mass if mass > 0.0 else np.zeros(3)
+    inertia = np.zeros((3, 3))
+    for lname, T, _ in parts:
+        lk = links[lname]
+        R = T[:3, :3]
+        c = R @ lk.com + T[:3, 3] - com
+        inertia += R @ lk.inertia @ R.T + lk.mass * (
+            (c @ c) * np.eye(3) - np.outer(c, c))
+    return mass, com, 0.5 * (inertia + inertia.T)
+
+
+def urdf_model(text, label='robot_description', base=None, tip=None,
+               gravity=(0.0, 0.0, -9.81)):
+    """
+    Build the chain model of URDF text; return (model, warnings, report).
+
+    ``report`` describes what was made of the tree: the chain's links and
+    joints, the merged fixed joints, the lumped subtrees and the frames
+    rigidly attached to the base and to the tip (for wrenches).
+    """
+    name, root, links, joints = parse_urdf(text, label)
+    found = []
+    base = root if base is None else base
+    for role, lname in (('base', base), ('tip', tip)):
+        if lname is not None and lname not in links:
+            raise RobotFileError(f'{label}: {role} link {_short(lname)!r} is '
+                                 f'not in the URDF')
+    if tip is None:
+        leaves = _leaves_below(links, joints, base)
+        if len(leaves) != 1:
+            raise RobotFileError(
+                f'{label}: the tree below {base!r} has {len(leaves)} leaves '
+                f'({_short(", ".join(leaves), 400)}); choose the tip link')
+        tip = leaves[0]
+    chain = _path(links, joints, base, tip)
+    if chain is None:
+        raise RobotFileError(f'{label}: base link {base!r} is not an '
+                             f'ancestor of tip link {tip!r}')
+    for jname in chain:
+        kind = joints[jname].kind
+        if kind in ('floating', 'planar'):
+            raise RobotFileError(
+                f'{label}: joint {jname!r} type: a {kind} joint is on the '
+                f'chain from {base!r} to {tip!r}; only revolute, continuous,'
+                f' prismatic and fixed joints can be')
+    moving = [j for j in chain if joints[j].kind in MOVING]
+    if not moving:
+        raise RobotFileError(f'{label}: no revolute, continuous or prismatic'
+                             f' joint between {base!r} and {tip!r}')
+    chain_set = set(chain)
+    chain_links = {base} | {joints[j].child for j in chain}
+    # ---- placements: fixed origins merged into the next moving joint ----
+    pre = []
+    merged = []
+    pending = []
+    for jname in chain:
+        joint = joints[jname]
+        if joint.kind == 'fixed':
+            pending += _origin_ops(joint.xyz, joint.rpy)
+            merged.append(jname)
+            continue
+        pre.append(tuple(pending + _origin_ops(joint.xyz, joint.rpy)))
+        pending = []
+    tool = np.eye(4)
+    for jname in chain[chain.index(moving[-1]) + 1:]:
+        tool = tool @ joints[jname].origin
+    # ---- the rigid body each moving joint carries ----
+    mass, com, inertia, carried = [], [], [], []
+    lumped = []
+    massless = []
+    for k, jname in enumerate(moving):
+        stop = {moving[k + 1]} if k + 1 < len(moving) else set()
+        parts = _lumped(links, joints, joints[jname].child, stop)
+        m, c, inertia_k = _combine(parts, links)
+        mass.append(m)
+        com.append(c)
+        inertia.append(inertia_k)
+        carried.append(parts)
+        for lname, _, via in parts:
+            if not links[lname].has_inertial:
+                massless.append(lname)
+            joint = joints[via] if via is not None else None
+            if joint is not None and via not in chain_set \
+                    and joint.parent in chain_links:
+                lumped.append((via, joint.kind))
+    # ---- frames rigidly attached to the tip and to the base ----
+    tip_frames = {}
+    tool_inv = np.linalg.inv(tool)
+    for lname, T, _ in carried[-1]:
+        tip_frames[lname] = tool_inv @ T
+    base_frames = {}
+    first_stop = {moving[0]}
+    for lname, T, via in _lumped(links, joints, base, first_stop):
+        if via is None or joints[via].kind == 'fixed':
+            base_frames[lname] = T
+    # links above the base, when they are joined to it by fixed joints
+    lname, T = base, np.eye(4)
+    while links[lname].parent_joint is not None:
+        joint = joints[links[lname].parent_joint]
+        if joint.kind != 'fixed':
+            break
+        T = T @ np.linalg.inv(joint.origin)
+        lname = joint.parent
+        base_frames[lname] = T
+    # ---- warnings ----
+    if lumped:
+        moved = [f'{v} ({kind})' for v, kind, *_ in lumped if kind != 'fixed']
+        found.append(
+            f'{label}: off-chain subtrees lumped rigidly into the chain at '
+            f'their zero position (their motion is not modelled): joints '
+            f'{_short(", ".join(v for v, *_ in lumped), 400)}'
+            + (f'; moving ones locked: {_short(", ".join(moved), 300)}'
+               if moved else ''))
+    if massless:
+        found.append(f'{label}: links without <inertial> are massless: '
+                     f'{_short(", ".join(sorted(set(massless))), 400)}')
+    for k, parts in enumerate(carried):
+        for lname, _, _ in parts:
+            lk = links[lname]
+            if lk.has_inertial:
+                eig = lk.eig
+                tol = 1e-9 * max(eig[2], 1e-300)
+                if eig[0] + eig[1] < eig[2] - tol:
+                    found.append(
+                        f'{label}: link {lname!r} <inertia>: principal '
+                        f'moments {eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} '
+                        f'break the triangle inequality (no real body has '
+                        f'them); accepted as published')
+    limits = []
+    for jname in moving:
+        lim = {}
+        for key, value in joints[jname].limits.items():
+            if key in ('velocity', 'effort') and not value > 0.0:
+                continue        # "0" is common for "not given"
+            lim[key] = value
+        limits.append(lim)
+    report = {
+        'base': base, 'tip': tip, 'chain': chain, 'moving': moving,
+        'chain_links': [joints[j].child for j in chain],
+        'links': [joints[j].child for j in moving],
+        'merged_fixed': merged, 'lumped': [v for v, *_ in lumped],
+        'tip_frames': tip_frames, 'base_frames': base_frames,
+        'continuous': [j for j in moving if joints[j].kind == 'continuous'],
+    }
+    model = make_chain(
+        name=name, joint_names=moving,
+        joint_types=[MOVING[joints[j].kind] for j in moving],
+        joint_pre=pre, joint_axis=[joints[j].axis for j in moving],
+        mass=mass, com=com, inertia=inertia, gravity=gravity, tool=tool,
+        limits=limits, info={'source': label, 'urdf': report})
+    return model, found, report
+
+
+def inspect_urdf(text_or_path, base=None, tip=None, label=None,
+                 gravity=(0.0, 0.0, -9.81)):
+    """Load a URDF (text or path); return (model, warnings, report)."""
+    text, label = read_urdf_text(text_or_path, label)
+    return urdf_model(text, label, base=base, tip=tip, gravity=gravity)
+
+
+def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):
+    """
+    Load a URDF, given as XML text or a file path, as a chain model.
+
+    ``gravity`` is in the base link's axes (URDF does not carry it).
+
+    Warnings are issued as
+    :class:`~newton_euler_ros.core.robot_file.RobotFileWarning`; errors
+    raise :class:`~newton_euler_ros.core.errors.RobotFileError`.
+    """
+    import warnings
+    from .robot_file import RobotFileWarning
+    model, found, _ = inspect_urdf(text_or_path, base=base, tip=tip,
+                                   gravity=gravity)
+    for message in found:
+        warnings.warn(message, RobotFileWarning, stacklevel=2)
+    return model
+
+
+# ---------------------------------------------------------------------------
+# writing: any model as URDF (for robot_state_publisher and RViz)
+# ---------------------------------------------------------------------------
+def matrix_rpy(R):
+    """ROS roll, pitch, yaw of a rotation matrix (R = Rz Ry Rx)."""
+    R = np.asarray(R, dtype=float)
+    cp = math.hypot(R[0, 0], R[1, 0])
+    pitch = math.atan2(-R[2, 0], cp)
+    if cp > 1e-12:
+        roll = math.atan2(R[2, 1], R[2, 2])
+        yaw = math.atan2(R[1, 0], R[0, 0])
+    else:   # gimbal lock: put the whole rotation about x into roll
+        roll = math.atan2(-R[1, 2], R[1, 1])
+        yaw = 0.0
+    return roll, pitch, yaw
+
+
+def _fmt(values):
+    return ' '.join(repr(float(v)) for v in values)
+
+
+def _origin_xml(T, indent):
+    xyz = T[:3, 3]
+    rpy = matrix_rpy(T[:3, :3])
+    return f'{indent}<origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>'
+
+
+def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
+    """
+    Return URDF text of a model: links with inertials, joints with limits.
+
+    URDF link k is the frame joint k moves (link frame k-1 . Pre_k . M(q));
+    the model's link frame k sits at Post_k in it, so the inertial origin
+    is Post_k applied to the centre of mass, with Post_k's rotation; joint
+    k's origin is Post_{k-1} Pre_k (the base pose for k = 1).  The end
+    effector is a fixed link ``tool_link``.  Loading the text back gives
+    the same dynamics (the tests check tau, D, C, g and J).
+    """
+    n = model.n
+    link_names = [f'link{k + 1}' for k in range(n)]
+    lines = ['<?xml version="1.0"?>',
+             f'<!-- {model.name}: written by newton-euler urdf from a '
+             f'{model.convention} model; gravity in {base_link} axes: '
+             f'{_fmt(model.gravity)} m/s^2 -->',
+             f'<robot name="{model.name}">',
+             f'  <link name="{base_link}"/>']
+    prev_post = np.asarray(model.base, dtype=float)
+    for k in range(n):
+        post = model.joint_post_matrix(k)
+        origin = prev_post @ model.joint_pre_matrix(k)
+        lim = model.limits[k] if k < len(model.limits) else {}
+        kind = model.joint_types[k]
+        if kind == REVOLUTE and not ('lower' in lim and 'upper' in lim):
+            kind = 'continuous'
+        parent = base_link if k == 0 else link_names[k - 1]
+        I = np.asarray(model.inertia[k])
+        com = post[:3, :3] @ model.com[k] + post[:3, 3]
+        inertial_pose = np.eye(4)
+        inertial_pose[:3, :3] = post[:3, :3]
+        inertial_pose[:3, 3] = com
+        lines += [
+            f'  <link name="{link_names[k]}">',
+            '    <inertial>',
+            _origin_xml(inertial_pose, '      '),
+            f'      <mass value="{_fmt([model.mass[k]])}"/>',
+            f'      <inertia ixx="{_fmt([I[0, 0]])}" ixy="{_fmt([I[0, 1]])}"'
+            f' ixz="{_fmt([I[0, 2]])}" iyy="{_fmt([I[1, 1]])}"'
+            f' iyz="{_fmt([I[1, 2]])}" izz="{_fmt([I[2, 2]])}"/>',
+            '    </inertial>',
+            '  </link>',
+            f'  <joint name="{model.joint_names[k]}" type="{kind}">',
+            f'    <parent link="{parent}"/>',
+            f'    <child link="{link_names[k]}"/>',
+            _origin_xml(origin, '    '),
+            f'    <axis xyz="{_fmt(model.joint_axis[k])}"/>']
+        attrs = [f'{key}="{_fmt([lim[key]])}"' for key in ('lower', 'upper')
+                 if key in lim and kind != 'continuous']
+        attrs += [f'{key}="{_fmt([lim.get(key, 0.0)])}"'
+                  for key in ('effort', 'velocity')]
+        lines += [f'    <limit {" ".join(attrs)}/>', '  </joint>']
+        prev_post = post
+    lines += [f'  <link name="{tool_link}"/>',
+              f'  <joint name="{tool_link}_joint" type="fixed">',
+              f'    <parent link="{link_names[-1]}"/>',
+              f'    <child link="{tool_link}"/>',
+              _origin_xml(prev_post @ np.asarray(model.tool, dtype=float),
+                          '    '),
+              '  </joint>',
+              '</robot>', '']
+    return '\n'.join(lines)
