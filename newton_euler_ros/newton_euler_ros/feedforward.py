@@ -145,11 +145,19 @@ class WrenchInput:
         ``'applied_to_robot'`` (what a wrist force/torque sensor reports:
         the wrench the environment applies; it is negated).
     timeout : seconds after which a wrench is stale (0 disables).
+    rigid_frames : optional ``{frame_id: (kind, T)}`` of frames rigidly
+        attached to the base (``kind`` ``'base'``) or to the end effector
+        (``'end_effector'``), with T the 4x4 pose of the frame in that one
+        (from a URDF).  A wrench in such a frame (moment about its origin)
+        is rotated into base or end-effector axes, and an end-effector
+        one also moved to the end-effector origin: n_ee = R n + p x R f.
+        A frame listed in ``base_frames`` / ``end_effector_frames`` uses
+        its transform when it is attached to that same side.
 
     """
 
     def __init__(self, base_frames, end_effector_frames,
-                 convention=EXERTED_BY_ROBOT, timeout=0.5):
+                 convention=EXERTED_BY_ROBOT, timeout=0.5, rigid_frames=None):
         both = set(base_frames) & set(end_effector_frames)
         if both:
             raise ValueError(f'frame {sorted(both)[0]!r} is listed as both a '
@@ -161,6 +169,14 @@ class WrenchInput:
             raise ValueError(f'wrench timeout must be >= 0 s, got {timeout}')
         self.frames = dict.fromkeys(base_frames, 'base')
         self.frames.update(dict.fromkeys(end_effector_frames, 'end_effector'))
+        self.transforms = {}
+        for frame_id, (kind, T) in (rigid_frames or {}).items():
+            if self.frames.setdefault(frame_id, kind) != kind:
+                continue        # listed for the other side: taken as axes
+            T = np.asarray(T, dtype=np.float64)
+            if np.array_equal(T, np.eye(4)):
+                continue
+            self.transforms[frame_id] = (T[:3, :3].copy(), T[:3, 3].copy())
         self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
         self.timeout = timeout
         self.wrench = None
@@ -190,6 +206,14 @@ class WrenchInput:
             raise InputRejected(
                 'stale', f'wrench is stamped {stamp - now:.3f} s in the '
                 f'future (timeout {self.timeout} s)')
+        moved = self.transforms.get(frame_id)
+        if moved is not None:
+            R, p = moved
+            f = R @ w[:3]
+            n = R @ w[3:]
+            if frame == 'end_effector':
+                n = n + np.cross(p, f)
+            w = np.concatenate([f, n])
         self.wrench = self.sign * w
         self.frame = frame
         self.stamp = stamp
@@ -208,6 +232,22 @@ class WrenchInput:
             self.expired += 1
             return None, self.frame
         return self.wrench, self.frame
+
+
+def rigid_frames(model):
+    """
+    Frames rigidly attached to a URDF model's base or tip, for wrenches.
+
+    Returns ``{link: (kind, T)}`` for :class:`WrenchInput` (empty for a DH
+    model): every link fixed to the end effector (T its pose in the
+    end-effector frame) and to the base (T its pose in the base frame).
+    """
+    report = model.info.get('urdf') or {}
+    out = {name: ('base', T)
+           for name, T in report.get('base_frames', {}).items()}
+    out.update((name, ('end_effector', T))
+               for name, T in report.get('tip_frames', {}).items())
+    return out
 
 
 class ReferenceTrajectory:

@@ -305,8 +305,10 @@ def test_stops_cleanly(graph):
                                            'of'),
     (['-p', 'qos.depth:=0'], 'qos.depth: must be > 0'),
     (['-p', 'scene:=no_such_scene'], 'scene: no_such_scene: no such file'),
-    (['-p', "robot_file:=''"],
-     'robot_file: must not be empty (or set scene)'),
+    (['-p', 'scene:=puma_payload_press', '-p', 'tip_link:=tool0'],
+     'base_link/tip_link: not with scene'),
+    (['-p', 'tip_link:=tool0'],
+     'robot_file: puma560: base and tip links apply to URDF robots'),
     (['-p', 'robot_file:='], 'cannot start'),
 ])
 def test_bad_parameters_refuse_to_start(tmp_path, args, message):

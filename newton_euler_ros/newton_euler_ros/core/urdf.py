@@ -692,7 +692,7 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
         if kind == REVOLUTE and not ('lower' in lim and 'upper' in lim):
             kind = 'continuous'
         parent = base_link if k == 0 else link_names[k - 1]
-        I = np.asarray(model.inertia[k])
+        inertia = np.asarray(model.inertia[k])
         com = post[:3, :3] @ model.com[k] + post[:3, 3]
         inertial_pose = np.eye(4)
         inertial_pose[:3, :3] = post[:3, :3]
@@ -702,9 +702,10 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
             '    <inertial>',
             _origin_xml(inertial_pose, '      '),
             f'      <mass value="{_fmt([model.mass[k]])}"/>',
-            f'      <inertia ixx="{_fmt([I[0, 0]])}" ixy="{_fmt([I[0, 1]])}"'
-            f' ixz="{_fmt([I[0, 2]])}" iyy="{_fmt([I[1, 1]])}"'
-            f' iyz="{_fmt([I[1, 2]])}" izz="{_fmt([I[2, 2]])}"/>',
+            '      <inertia ' + ' '.join(
+                f'{key}="{_fmt([inertia[i, k]])}"' for key, i, k in (
+                    ('ixx', 0, 0), ('ixy', 0, 1), ('ixz', 0, 2),
+                    ('iyy', 1, 1), ('iyz', 1, 2), ('izz', 2, 2))) + '/>',
             '    </inertial>',
             '  </link>',
             f'  <joint name="{model.joint_names[k]}" type="{kind}">',

@@ -21,7 +21,9 @@ result is published.  See the README ("ROS 2 node") for the interface.
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
     WrenchStamped), ~/reference (trajectory_msgs/JointTrajectory, only
-    with acceleration_source = reference)
+    with acceleration_source = reference), robot_description
+    (std_msgs/String, reliable + transient local, only when neither
+    scene nor robot_file is set)
 Publishes
     ~/torque_command (std_msgs/Float64MultiArray), ~/torques
     (sensor_msgs/JointState), /diagnostics (diagnostic_msgs/DiagnosticArray)
@@ -29,6 +31,7 @@ Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
 import sys
+import threading
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
@@ -37,15 +40,17 @@ from newton_euler_interfaces.srv import ComputeDynamics
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray
+from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import ConfigurationError, qos_profile, run_node
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
+from ..core.urdf import urdf_model
 from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
-                           ReferenceTrajectory, WrenchInput)
+                           ReferenceTrajectory, rigid_frames, WrenchInput)
 from ..parameters import load_specs, validate
 
 _PARAM_TYPES = {
@@ -56,7 +61,12 @@ _PARAM_TYPES = {
 }
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
-            'service_calls', 'service_failures', 'internal_error')
+            'service_calls', 'service_failures', 'internal_error',
+            'no_model', 'descriptions_loaded', 'descriptions_rejected')
+# robot_state_publisher's QoS for robot_description: a late subscriber
+# still gets the last description, but only with the same durability
+DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
 
 
 def _seconds(stamp):
@@ -69,36 +79,48 @@ class InverseDynamicsNode(Node):
     def __init__(self, **kwargs):
         super().__init__('inverse_dynamics_node', **kwargs)
         self.specs = load_specs()
-        p = self._declare_parameters()
+        p = self.params = self._declare_parameters()
+        self.counts = dict.fromkeys(COUNTERS, 0)
+        self.log_throttle = p['log_throttle']
+        self._last_log = {}
+        self.ff = None          # swapped whole when a new model arrives
+        self.model_source = ''
         scene = None
+        if (p['base_link'] or p['tip_link']) and p['scene']:
+            raise ConfigurationError('base_link/tip_link: not with scene '
+                                     '(the scene names its robot)')
         try:
             if p['scene']:
                 scene = load_scene(p['scene'])
                 model, found, path = (scene.model, scene.warnings,
                                       scene.robot_path)
             elif p['robot_file']:
-                model, found, path = inspect_robot(p['robot_file'])
+                model, found, path = inspect_robot(
+                    p['robot_file'], base=p['base_link'] or None,
+                    tip=p['tip_link'] or None)
             else:
-                raise ConfigurationError(
-                    'robot_file: must not be empty (or set scene)')
+                model = None
         except NewtonEulerError as exc:
             key = 'scene' if p['scene'] else 'robot_file'
             raise ConfigurationError(f'{key}: {exc}') from None
-        for message in found:
-            self.get_logger().warning(f'robot file: {message}')
-        try:
-            order = JointOrder(model.joint_names, p['joints'] or None)
-            wrench = self._wrench_input(p)
-        except ValueError as exc:
-            raise ConfigurationError(str(exc)) from None
-        reference = (ReferenceTrajectory(order)
-                     if p['acceleration_source'] == 'reference' else None)
-        self.ff = FeedforwardComputer(model, order, wrench, reference,
-                                      scene)
-        self.ff.warm_up()   # compile or load the kernels before any message
-        self.counts = dict.fromkeys(COUNTERS, 0)
-        self.log_throttle = p['log_throttle']
-        self._last_log = {}
+        if model is not None:
+            for message in found:
+                self.get_logger().warning(f'robot file: {message}')
+            try:
+                self.ff = self._make_computer(model, scene)
+            except ValueError as exc:
+                raise ConfigurationError(str(exc)) from None
+            self.model_source = path
+        else:
+            # wait for robot_state_publisher's description; parse it off
+            # the executor thread, swap the computer in when it is ready
+            self._description_lock = threading.Lock()
+            self._description_seq = 0
+            self.create_subscription(String, 'robot_description',
+                                     self._on_description, DESCRIPTION_QOS)
+            self.get_logger().info(
+                'no robot_file or scene: waiting for the robot_description '
+                'topic; publishing nothing until it arrives')
 
         qos = qos_profile(p['qos.depth'], p['qos.reliability'])
         self.cmd_pub = self.create_publisher(Float64MultiArray,
@@ -108,7 +130,7 @@ class InverseDynamicsNode(Node):
                                  self._on_joint_state, qos)
         self.create_subscription(WrenchStamped, 'wrench', self._on_wrench,
                                  qos)
-        if reference is not None:
+        if p['acceleration_source'] == 'reference':
             self.create_subscription(JointTrajectory, '~/reference',
                                      self._on_reference, 10)
         self.create_service(ComputeDynamics, '~/compute_dynamics',
@@ -121,14 +143,69 @@ class InverseDynamicsNode(Node):
         # reused messages: the hot path allocates no message objects
         self._cmd = Float64MultiArray()
         self._torques = JointState()
-        self._torques.name = list(order.output_joints)
+        if self.ff is not None:
+            self._log_model(self.ff, self.model_source)
+
+    def _make_computer(self, model, scene=None):
+        """Joint order, wrench input and a warm computer for a model."""
+        p = self.params
+        order = JointOrder(model.joint_names, p['joints'] or None)
+        wrench = self._wrench_input(p, model)
+        reference = (ReferenceTrajectory(order)
+                     if p['acceleration_source'] == 'reference' else None)
+        ff = FeedforwardComputer(model, order, wrench, reference, scene)
+        ff.warm_up()   # compile or load the kernels before any message
+        ff.output_names = list(order.output_joints)
+        return ff
+
+    def _log_model(self, ff, source):
+        model = ff.model
+        effects = (ff.scene.effects.names() if ff.scene is not None
+                   else 'all rigid-body')
         self.get_logger().info(
-            f'{model.name} ({path}): {model.n} joints '
-            f'[{", ".join(order.output_joints)}], qdd from '
-            f'{p["acceleration_source"]}, effects '
-            f'{scene.effects.names() if scene else "all rigid-body"}, '
-            f'wrench frames '
-            f'{sorted(wrench.frames)}')
+            f'{model.name} ({source}): {model.n} joints '
+            f'[{", ".join(ff.output_names)}], qdd from '
+            f'{self.params["acceleration_source"]}, effects {effects}, '
+            f'wrench frames {sorted(ff.wrench.frames)}')
+
+    # ---- robot_description ----
+    def _on_description(self, msg):
+        with self._description_lock:
+            self._description_seq += 1
+            seq = self._description_seq
+        threading.Thread(target=self._load_description,
+                         args=(msg.data, seq), daemon=True).start()
+
+    def _load_description(self, text, seq):
+        p = self.params
+        try:
+            model, found, report = urdf_model(
+                text, 'robot_description', base=p['base_link'] or None,
+                tip=p['tip_link'] or None)
+            ff = self._make_computer(model)
+        except (NewtonEulerError, ValueError) as exc:
+            self.counts['descriptions_rejected'] += 1
+            keep = ('the previous model keeps working' if self.ff is not None
+                    else 'still no model: publishing nothing')
+            self.get_logger().error(
+                f'robot_description rejected: {_clip(str(exc))}; {keep}')
+            return
+        except Exception as exc:  # never let a description kill the node
+            self.counts['descriptions_rejected'] += 1
+            self.get_logger().error(
+                f'robot_description rejected (internal error): '
+                f'{_clip(str(exc))}')
+            return
+        with self._description_lock:
+            if seq != self._description_seq:
+                return          # a newer description is on its way
+            for message in found:
+                self.get_logger().warning(_clip(message))
+            self.ff = ff        # one reference swap: callbacks see either
+            self.counts['descriptions_loaded'] += 1
+            self.model_source = (f'robot_description, {report["base"]} -> '
+                                 f'{report["tip"]}')
+        self._log_model(ff, self.model_source)
 
     # ---- parameters ----
     def _declare_parameters(self):
@@ -153,10 +230,11 @@ class InverseDynamicsNode(Node):
             raise ConfigurationError('; '.join(errors))
         return values
 
-    def _wrench_input(self, p):
+    def _wrench_input(self, p, model):
         return WrenchInput(p['wrench.base_frames'],
                            p['wrench.end_effector_frames'],
-                           p['wrench.convention'], p['wrench.timeout'])
+                           p['wrench.convention'], p['wrench.timeout'],
+                           rigid_frames(model))
 
     def _on_set_parameters(self, params):
         values = {}
@@ -173,12 +251,16 @@ class InverseDynamicsNode(Node):
                    for s in self.specs if s.name.startswith('wrench.')}
         current = {k: list(v) if isinstance(v, tuple) else v
                    for k, v in current.items()}
-        try:
-            new_wrench = self._wrench_input(current)
-        except ValueError as exc:
-            return SetParametersResult(successful=False, reason=str(exc))
-        if any(name.startswith('wrench.') for name in values):
-            self.ff.wrench = new_wrench
+        ff = self.ff
+        if ff is not None:
+            try:
+                new_wrench = self._wrench_input(current, ff.model)
+            except ValueError as exc:
+                return SetParametersResult(successful=False,
+                                           reason=str(exc))
+            if any(name.startswith('wrench.') for name in values):
+                ff.wrench = new_wrench
+        self.params.update(values)
         if 'log_throttle' in values:
             self.log_throttle = values['log_throttle']
         return SetParametersResult(successful=True)
@@ -199,15 +281,23 @@ class InverseDynamicsNode(Node):
                 f'dropped {source}: {exc} ({kind}: {self.counts[kind]} so '
                 f'far)')
 
+    def _no_model(self, _source):
+        # said once at start-up and in /diagnostics; counted, not logged
+        self.counts['no_model'] += 1
+
     def _on_joint_state(self, msg):
+        ff = self.ff
+        if ff is None:
+            self._no_model('joint state')
+            return
         try:
-            expired = self.ff.wrench.expired
-            tau = self.ff.torques(msg.name, msg.position, msg.velocity,
-                                  _seconds(msg.header.stamp), self._now())
-            if self.ff.wrench.expired != expired:
+            expired = ff.wrench.expired
+            tau = ff.torques(msg.name, msg.position, msg.velocity,
+                             _seconds(msg.header.stamp), self._now())
+            if ff.wrench.expired != expired:
                 self._reject('wrench', InputRejected(
                     'expired', 'the last wrench is older than '
-                    f'{self.ff.wrench.timeout} s; torques no longer include '
+                    f'{ff.wrench.timeout} s; torques no longer include '
                     f'it'))
         except InputRejected as exc:
             self._reject('joint state', exc)
@@ -219,14 +309,19 @@ class InverseDynamicsNode(Node):
         self._cmd.data = values
         self.cmd_pub.publish(self._cmd)
         self._torques.header.stamp = msg.header.stamp
+        self._torques.name = ff.output_names
         self._torques.effort = values
         self.torque_pub.publish(self._torques)
         self.counts['published'] += 1
 
     def _on_wrench(self, msg):
         w = msg.wrench
+        ff = self.ff
+        if ff is None:
+            self._no_model('wrench')
+            return
         try:
-            self.ff.wrench.update(
+            ff.wrench.update(
                 msg.header.frame_id,
                 (w.force.x, w.force.y, w.force.z,
                  w.torque.x, w.torque.y, w.torque.z),
@@ -237,11 +332,15 @@ class InverseDynamicsNode(Node):
             self._reject('wrench', exc)
 
     def _on_reference(self, msg):
+        ff = self.ff
+        if ff is None:
+            self._no_model('reference')
+            return
         try:
             points = [(_seconds(pt.time_from_start), pt.accelerations)
                       for pt in msg.points]
-            self.ff.reference.set(msg.joint_names, _seconds(msg.header.stamp),
-                                  points, self._now())
+            ff.reference.set(msg.joint_names, _seconds(msg.header.stamp),
+                             points, self._now())
         except InputRejected as exc:
             self._reject('reference', exc)
         except Exception as exc:
@@ -249,8 +348,15 @@ class InverseDynamicsNode(Node):
 
     def _on_compute_dynamics(self, request, response):
         self.counts['service_calls'] += 1
+        ff = self.ff
+        if ff is None:
+            self.counts['service_failures'] += 1
+            response.success = False
+            response.message = ('no robot model yet (waiting for '
+                                'robot_description)')
+            return response
         try:
-            D, C, g, tau = self.ff.terms(
+            D, C, g, tau = ff.terms(
                 request.name, request.position, request.velocity,
                 request.acceleration, self._now())
         except (InputRejected, NewtonEulerError) as exc:
@@ -266,7 +372,7 @@ class InverseDynamicsNode(Node):
             return response
         response.success = True
         response.message = ''
-        response.name = list(self.ff.order.output_joints)
+        response.name = list(ff.output_names)
         response.mass_matrix = D.ravel().tolist()
         response.coriolis_matrix = C.ravel().tolist()
         response.gravity = g.tolist()
@@ -274,14 +380,23 @@ class InverseDynamicsNode(Node):
         return response
 
     def _publish_counts(self):
+        ff = self.ff
         status = DiagnosticStatus(
-            level=DiagnosticStatus.OK, name=self.get_fully_qualified_name(),
-            message='input counters', hardware_id=self.ff.model.name)
+            level=DiagnosticStatus.OK if ff is not None
+            else DiagnosticStatus.WARN,
+            name=self.get_fully_qualified_name(),
+            message=('input counters' if ff is not None else
+                     'waiting for robot_description: publishing nothing'),
+            hardware_id=ff.model.name if ff is not None else '')
         status.values = [KeyValue(key=k, value=str(v))
                          for k, v in self.counts.items()]
         msg = DiagnosticArray(status=[status])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
+
+
+def _clip(text, limit=400):
+    return text if len(text) <= limit else text[:limit] + '...'
 
 
 def main(args=None):
