@@ -40,6 +40,7 @@ demo: setup
 bench: setup
 	$(PY) -m newton_euler_ros.bench
 	$(PY) -m newton_euler_ros.bench_effects
+	$(PY) -m newton_euler_ros.bench_urdf
 
 latency: setup
 	$(PY) -m newton_euler_ros.latency_bench

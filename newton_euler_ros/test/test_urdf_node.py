@@ -41,7 +41,8 @@ from newton_euler_ros.core.model import rpy_matrix  # noqa: E402
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
-from ros_harness import domain_id, NodeProcess, Probe  # noqa: E402
+from ros_harness import (domain_id, NodeProcess, PARAMS_DIR,  # noqa: E402
+                         Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
@@ -61,7 +62,10 @@ def node_cmd(*extra):
                           'inverse_dynamics_node')
     base = [script] if os.path.exists(script) else [
         sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
-    return base + ['--ros-args', '-p', 'tip_link:=tool0',
+    # the bundled parameter file for URDF robots, as the README runs it
+    return base + ['--ros-args', '--params-file',
+                   os.path.join(PARAMS_DIR, 'urdf.yaml'),
+                   '-p', 'base_link:=base_link', '-p', 'tip_link:=tool0',
                    '-p', 'log_throttle:=0.01', *extra]
 
 

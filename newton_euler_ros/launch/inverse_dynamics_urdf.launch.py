@@ -1,0 +1,73 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Launch inverse_dynamics_node on the robot's own URDF (apt ROS).
+
+    ros2 launch newton_euler_ros inverse_dynamics_urdf.launch.py \
+        base_link:=base_link tip_link:=tool0
+
+Beside robot_state_publisher: the node reads the URDF from the
+``robot_description`` topic (reliable, transient local), so no robot file
+is written by hand.  Remap ``robot_description``, ``joint_states``,
+``wrench`` and the torque command as your graph needs, e.g.
+``torque_command:=/effort_controller/commands``.
+"""
+import os
+
+from ament_index_python.packages import get_package_share_directory
+from launch import LaunchDescription
+from launch.actions import DeclareLaunchArgument
+from launch.substitutions import LaunchConfiguration
+from launch_ros.actions import Node
+
+
+def generate_launch_description():
+    share = get_package_share_directory('newton_euler_ros')
+    arg = LaunchConfiguration
+    return LaunchDescription([
+        DeclareLaunchArgument('base_link', default_value='base_link',
+                              description='first link of the chain'),
+        DeclareLaunchArgument('tip_link', default_value='tool0',
+                              description='last link: the end effector'),
+        DeclareLaunchArgument(
+            'params_file',
+            default_value=os.path.join(share, 'config', 'params',
+                                       'urdf.yaml'),
+            description='parameter file (wrench frames, QoS, ...)'),
+        DeclareLaunchArgument('robot_description',
+                              default_value='robot_description'),
+        DeclareLaunchArgument('joint_states', default_value='joint_states'),
+        DeclareLaunchArgument('wrench', default_value='wrench'),
+        DeclareLaunchArgument(
+            'torque_command',
+            default_value='inverse_dynamics_node/torque_command',
+            description='topic of the Float64MultiArray command, e.g. '
+                        '/effort_controller/commands'),
+        Node(
+            package='newton_euler_ros',
+            executable='inverse_dynamics_node',
+            name='inverse_dynamics_node',
+            output='screen',
+            parameters=[arg('params_file'),
+                        {'base_link': arg('base_link'),
+                         'tip_link': arg('tip_link')}],
+            remappings=[
+                ('robot_description', arg('robot_description')),
+                ('joint_states', arg('joint_states')),
+                ('wrench', arg('wrench')),
+                ('~/torque_command', arg('torque_command')),
+            ],
+        ),
+    ])
