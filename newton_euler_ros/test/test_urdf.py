@@ -498,3 +498,16 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
     assert 'massless: tool0' in out
     code, out, err = run_cli('check', str(path))
     assert code != 0 and err.count('\n') == 1 and '2 leaves' in err
+
+
+def test_float32_runs_the_same_kernels_on_a_urdf_model():
+    from newton_euler_ros.core.float32 import Float32Dynamics
+    model = arm(base='world', tip='tool0')
+    f32 = Float32Dynamics(model)
+    rng = np.random.default_rng(9)
+    q, qd, qdd = rng.uniform(-1.5, 1.5, size=(3, model.n))
+    tau = f32.inverse_dynamics(q, qd, qdd)
+    assert tau.dtype == np.float32
+    # a few float32 ulp of the float64 torques
+    assert rel(tau, inverse_dynamics(model, q, qd, qdd)) < 100 * model.n * \
+        np.finfo(np.float32).eps
