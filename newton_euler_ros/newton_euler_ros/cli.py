@@ -21,6 +21,7 @@
     newton-euler dynamics ROBOT --states STATES.json
     newton-euler check ROBOT
     newton-euler urdf ROBOT [-o FILE]
+    newton-euler feedforward ROBOT TRAJECTORY.json [--wrench ...]
     newton-euler robots
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
@@ -263,6 +264,29 @@ def cmd_simulate(args):
     return 0
 
 
+def cmd_feedforward(args):
+    from .core.trajectory import fill_efforts
+    model, found, _ = _load(args)
+    for message in found:
+        print(f'warning: {message}', file=sys.stderr)
+    path = args.trajectory
+    try:
+        with open(path, encoding='utf-8') as fh:
+            trajectory = json.load(fh)
+    except OSError as exc:
+        raise CliError(f'{path}: cannot read: {exc.strerror}') from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise CliError(f'{path}: not valid JSON: {exc}') from None
+    if not isinstance(trajectory, dict):
+        raise CliError(f'{path}: must hold a JSON object with "joint_names"'
+                       f' and "points"')
+    wrench = (np.array(_numbers(args.wrench, '--wrench'))
+              if args.wrench is not None else None)
+    print(json.dumps(fill_efforts(model, trajectory, wrench,
+                                  args.wrench_frame, where=f'{path}: ')))
+    return 0
+
+
 def cmd_urdf(args):
     from .core.urdf import model_to_urdf
     model, found, _ = _load(args)
@@ -348,6 +372,20 @@ def build_parser():
                      help='PD alone, without the inverse-dynamics '
                           'feedforward (for comparison)')
     sim.set_defaults(func=cmd_simulate)
+    ff = sub.add_parser('feedforward', help='fill the effort of every point '
+                                            'of a joint trajectory')
+    ff.add_argument('robot')
+    ff.add_argument('trajectory', help='JSON: {"joint_names": [...], '
+                                       '"points": [{"time_from_start": t, '
+                                       '"positions": [...], ...}]}')
+    ff.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
+                                                  'NY', 'NZ'),
+                    help='wrench the end effector exerts along the whole '
+                         'trajectory')
+    ff.add_argument('--wrench-frame', choices=('base', 'end_effector'),
+                    default='base')
+    _chain_options(ff)
+    ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
     return parser

@@ -35,6 +35,7 @@ import numpy as np
 
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
                    inverse_dynamics, mass_matrix, Workspace)
+from .core.model import with_payload
 from .core.simulate import SceneDynamics
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
@@ -234,6 +235,51 @@ class WrenchInput:
         return self.wrench, self.frame
 
 
+MODES = ('gravity', 'gravity_coriolis', 'full')
+
+
+def check_payload(mass, com, inertia6):
+    """
+    Validate payload values; return (mass, com, 3x3 inertia) or ValueError.
+
+    ``inertia6`` is [Ixx, Iyy, Izz, Ixy, Iyz, Ixz] about the payload's
+    centre of mass ``com`` (end-effector frame).
+    """
+    mass = float(mass)
+    com = np.asarray(com, dtype=np.float64).reshape(-1)
+    values = np.asarray(inertia6, dtype=np.float64).reshape(-1)
+    if not (mass >= 0.0 and math.isfinite(mass)):
+        raise ValueError(f'payload.mass: must be >= 0 and finite, got {mass}')
+    if com.shape != (3,) or not np.isfinite(com).all():
+        raise ValueError(f'payload.com: must be 3 finite numbers, got '
+                         f'{com.tolist()}')
+    if values.shape != (6,) or not np.isfinite(values).all():
+        raise ValueError(f'payload.inertia: must be 6 finite numbers, got '
+                         f'{values.tolist()}')
+    ixx, iyy, izz, ixy, iyz, ixz = values
+    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    eig = np.linalg.eigvalsh(inertia)
+    if eig[0] < -1e-12 * max(abs(eig).max(), 1e-300):
+        raise ValueError(f'payload.inertia: not positive semi-definite '
+                         f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
+                         f'{eig[2]:.6g})')
+    return mass, com, inertia
+
+
+def payload_model(model, mass, com, inertia6):
+    """
+    Return the model with a payload on the end effector, or ValueError.
+
+    Merged into the last link by
+    :func:`~newton_euler_ros.core.model.with_payload`, the scenes' code;
+    no payload (all zeros) returns ``model`` itself.
+    """
+    mass, com, inertia = check_payload(mass, com, inertia6)
+    if mass == 0.0 and not inertia.any():
+        return model
+    return with_payload(model, mass, com, inertia)
+
+
 def rigid_frames(model):
     """
     Frames rigidly attached to a URDF model's base or tip, for wrenches.
@@ -307,7 +353,12 @@ class FeedforwardComputer:
     """
 
     def __init__(self, model, order, wrench_input, reference=None,
-                 scene=None):
+                 scene=None, mode=None):
+        self.mode = mode or ('full' if reference is not None
+                             else 'gravity_coriolis')
+        if self.mode not in MODES:
+            raise ValueError(f'mode must be one of {", ".join(MODES)}, got '
+                             f'{self.mode!r}')
         self.scene = scene
         self.dyn = SceneDynamics(scene) if scene is not None else None
         self.model = scene.model if scene is not None else model
@@ -316,6 +367,7 @@ class FeedforwardComputer:
         self.reference = reference
         self.ws = self.dyn.ws if self.dyn is not None else Workspace(model)
         self.tau = np.empty(self.model.n)
+        self.zeros = np.zeros(self.model.n)
         self.last_q = None
         self.last_qd = None
 
@@ -353,9 +405,12 @@ class FeedforwardComputer:
         if qd is None:
             qd = np.zeros(self.model.n)
         qdd = (self.reference.acceleration(stamp)
-               if self.reference is not None else None)
+               if self.mode == 'full' and self.reference is not None
+               else None)
         w, frame = self.wrench.current(now)
-        tau = self._torques(q, qd, qdd, w, frame, out=self.tau)
+        # gravity mode: the state's velocity takes no part in the torque
+        qd_used = qd if self.mode != 'gravity' else self.zeros
+        tau = self._torques(q, qd_used, qdd, w, frame, out=self.tau)
         if not np.isfinite(tau).all():   # finite input; guard the output
             raise InputRejected('non_finite', 'dynamics produced a '
                                 'non-finite torque')

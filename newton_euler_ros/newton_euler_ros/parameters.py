@@ -62,6 +62,12 @@ class ParameterSpec:
         if self.type == 'string_array' and not all(isinstance(v, str)
                                                    for v in value):
             return f'{self.name}: must be a list of strings, got {value!r}'
+        if self.type == 'double_array':
+            bad = [v for v in value if isinstance(v, bool) or not isinstance(
+                v, (int, float)) or not math.isfinite(v)]
+            if bad:
+                return (f'{self.name}: must be a list of finite numbers, '
+                        f'got {bad[0]!r}')
         for rule, args in self.validation.items():
             reason = _RULES[rule](value, *(args or []))
             if reason:
@@ -86,13 +92,19 @@ def _not_empty(value):
     return '' if len(value) else 'must not be empty'
 
 
+def _fixed_size(value, size):
+    return '' if len(value) == size else (
+        f'must have {size} entries, got {len(value)}')
+
+
 def _unique(value):
     dup = [v for i, v in enumerate(value) if v in value[:i]]
     return '' if not dup else f'{dup[0]!r} is listed twice'
 
 
 _RULES = {'one_of<>': _one_of, 'gt<>': _gt, 'gt_eq<>': _gt_eq,
-          'not_empty<>': _not_empty, 'unique<>': _unique}
+          'not_empty<>': _not_empty, 'unique<>': _unique,
+          'fixed_size<>': _fixed_size}
 
 
 def _flatten(tree, prefix=''):

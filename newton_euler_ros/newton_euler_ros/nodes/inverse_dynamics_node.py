@@ -24,12 +24,16 @@ Subscribes
     with acceleration_source = reference), robot_description
     (std_msgs/String, reliable + transient local, only when neither
     scene nor robot_file is set)
+    ~/trajectory_in (trajectory_msgs/JointTrajectory): a planned
+    trajectory whose points get their effort filled
 Publishes
     ~/torque_command (std_msgs/Float64MultiArray), ~/torques
-    (sensor_msgs/JointState), /diagnostics (diagnostic_msgs/DiagnosticArray)
+    (sensor_msgs/JointState), ~/trajectory_out (trajectory_msgs/
+    JointTrajectory), /diagnostics (diagnostic_msgs/DiagnosticArray)
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
+import dataclasses
 import sys
 import threading
 import time
@@ -48,8 +52,10 @@ from trajectory_msgs.msg import JointTrajectory
 from .common import ConfigurationError, qos_profile, run_node
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
+from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
-from ..feedforward import (FeedforwardComputer, InputRejected, JointOrder,
+from ..feedforward import (check_payload, FeedforwardComputer,
+                           InputRejected, JointOrder, payload_model,
                            ReferenceTrajectory, rigid_frames, WrenchInput)
 from ..parameters import load_specs, validate
 
@@ -62,7 +68,8 @@ _PARAM_TYPES = {
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
             'service_calls', 'service_failures', 'internal_error',
-            'no_model', 'descriptions_loaded', 'descriptions_rejected')
+            'no_model', 'descriptions_loaded', 'descriptions_rejected',
+            'trajectories', 'payload_changes')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -86,6 +93,15 @@ class InverseDynamicsNode(Node):
         self.ff = None          # swapped whole when a new model arrives
         self.model_source = ''
         scene = None
+        if p['mode'] in ('gravity', 'gravity_coriolis') and \
+                p['acceleration_source'] == 'reference':
+            raise ConfigurationError(
+                f'acceleration_source: reference needs mode full (or an '
+                f'empty mode), not {p["mode"]}')
+        self.mode = p['mode'] or ('full' if p['acceleration_source'] ==
+                                  'reference' else 'gravity_coriolis')
+        self.payload = (p['payload.mass'], p['payload.com'],
+                        p['payload.inertia'])
         if (p['base_link'] or p['tip_link']) and p['scene']:
             raise ConfigurationError('base_link/tip_link: not with scene '
                                      '(the scene names its robot)')
@@ -130,9 +146,13 @@ class InverseDynamicsNode(Node):
                                  self._on_joint_state, qos)
         self.create_subscription(WrenchStamped, 'wrench', self._on_wrench,
                                  qos)
-        if p['acceleration_source'] == 'reference':
+        if self.mode == 'full':
             self.create_subscription(JointTrajectory, '~/reference',
                                      self._on_reference, 10)
+        self.traj_pub = self.create_publisher(JointTrajectory,
+                                              '~/trajectory_out', 10)
+        self.create_subscription(JointTrajectory, '~/trajectory_in',
+                                 self._on_trajectory, 10)
         self.create_service(ComputeDynamics, '~/compute_dynamics',
                             self._on_compute_dynamics)
         if p['diagnostics_period'] > 0.0:
@@ -146,16 +166,35 @@ class InverseDynamicsNode(Node):
         if self.ff is not None:
             self._log_model(self.ff, self.model_source)
 
-    def _make_computer(self, model, scene=None):
-        """Joint order, wrench input and a warm computer for a model."""
+    def _make_computer(self, model, scene=None, previous=None,
+                       payload=None):
+        """
+        Joint order, wrench input and a warm computer for a model.
+
+        The run-time payload is merged into ``model`` (the model without
+        it, kept as ``ff.bare_model``).  With ``previous`` (same joints)
+        its joint order, wrench and reference carry over, so a payload
+        change rebuilds only the model and its workspace.
+        """
         p = self.params
-        order = JointOrder(model.joint_names, p['joints'] or None)
-        wrench = self._wrench_input(p, model)
-        reference = (ReferenceTrajectory(order)
-                     if p['acceleration_source'] == 'reference' else None)
-        ff = FeedforwardComputer(model, order, wrench, reference, scene)
+        bare = model
+        model = payload_model(bare, *(payload or self.payload))
+        if scene is not None:
+            scene = dataclasses.replace(scene, model=model)
+        if previous is not None:
+            order, wrench = previous.order, previous.wrench
+            reference = previous.reference
+        else:
+            order = JointOrder(model.joint_names, p['joints'] or None)
+            wrench = self._wrench_input(p, model)
+            reference = (ReferenceTrajectory(order)
+                         if self.mode == 'full' else None)
+        ff = FeedforwardComputer(model, order, wrench, reference, scene,
+                                 self.mode)
         ff.warm_up()   # compile or load the kernels before any message
         ff.output_names = list(order.output_joints)
+        ff.bare_model = bare
+        ff.bare_scene = scene if previous is None else previous.bare_scene
         return ff
 
     def _log_model(self, ff, source):
@@ -164,9 +203,9 @@ class InverseDynamicsNode(Node):
                    else 'all rigid-body')
         self.get_logger().info(
             f'{model.name} ({source}): {model.n} joints '
-            f'[{", ".join(ff.output_names)}], qdd from '
-            f'{self.params["acceleration_source"]}, effects {effects}, '
-            f'wrench frames {sorted(ff.wrench.frames)}')
+            f'[{", ".join(ff.output_names)}], mode {self.mode}, effects '
+            f'{effects}, payload {self.payload[0]} kg, wrench frames '
+            f'{_clip(str(sorted(ff.wrench.frames)))}')
 
     # ---- robot_description ----
     def _on_description(self, msg):
@@ -251,15 +290,38 @@ class InverseDynamicsNode(Node):
                    for s in self.specs if s.name.startswith('wrench.')}
         current = {k: list(v) if isinstance(v, tuple) else v
                    for k, v in current.items()}
+        payload = tuple(values.get(k, self.params[k]) for k in (
+            'payload.mass', 'payload.com', 'payload.inertia'))
         ff = self.ff
+        new_ff = None
         if ff is not None:
             try:
                 new_wrench = self._wrench_input(current, ff.model)
+                if payload != self.payload:
+                    # a new model and workspace, built here, off the hot
+                    # path; everything else carries over
+                    new_ff = self._make_computer(
+                        ff.bare_model, ff.bare_scene, previous=ff,
+                        payload=payload)
             except ValueError as exc:
                 return SetParametersResult(successful=False,
                                            reason=str(exc))
             if any(name.startswith('wrench.') for name in values):
                 ff.wrench = new_wrench
+        else:
+            try:        # no model yet: check the payload values alone
+                check_payload(*payload)
+            except ValueError as exc:
+                return SetParametersResult(successful=False,
+                                           reason=str(exc))
+        if payload != self.payload:
+            self.payload = payload
+            self.counts['payload_changes'] += 1
+            if new_ff is not None:
+                self.ff = new_ff
+            self.get_logger().info(
+                f'payload now {payload[0]} kg at {list(payload[1])} m '
+                f'(end-effector frame)')
         self.params.update(values)
         if 'log_throttle' in values:
             self.log_throttle = values['log_throttle']
@@ -346,6 +408,33 @@ class InverseDynamicsNode(Node):
         except Exception as exc:
             self._reject('reference', exc)
 
+    def _on_trajectory(self, msg):
+        ff = self.ff
+        if ff is None:
+            self._no_model('trajectory')
+            return
+        try:
+            points = [{'time_from_start': _seconds(pt.time_from_start),
+                       'positions': pt.positions,
+                       'velocities': pt.velocities,
+                       'accelerations': pt.accelerations}
+                      for pt in msg.points]
+            w, frame = (ff.wrench.current(self._now())
+                        if self.params['trajectory.include_wrench']
+                        else (None, 'base'))
+            efforts = trajectory_efforts(ff.model, msg.joint_names, points,
+                                         w, frame, 'trajectory: ', ff.ws)
+        except NewtonEulerError as exc:
+            self._reject('trajectory', InputRejected('malformed', str(exc)))
+            return
+        except Exception as exc:
+            self._reject('trajectory', exc)
+            return
+        for pt, effort in zip(msg.points, efforts):
+            pt.effort = effort.tolist()
+        self.traj_pub.publish(msg)
+        self.counts['trajectories'] += 1
+
     def _on_compute_dynamics(self, request, response):
         self.counts['service_calls'] += 1
         ff = self.ff
@@ -390,7 +479,18 @@ class InverseDynamicsNode(Node):
             hardware_id=ff.model.name if ff is not None else '')
         status.values = [KeyValue(key=k, value=str(v))
                          for k, v in self.counts.items()]
-        msg = DiagnosticArray(status=[status])
+        model = DiagnosticStatus(
+            level=DiagnosticStatus.OK, name=self.get_fully_qualified_name()
+            + ': model', message=f'mode {self.mode}',
+            hardware_id=ff.model.name if ff is not None else '')
+        model.values = [
+            KeyValue(key='mode', value=self.mode),
+            KeyValue(key='payload.mass', value=repr(self.payload[0])),
+            KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
+            KeyValue(key='payload.inertia',
+                     value=repr(list(self.payload[2]))),
+            KeyValue(key='source', value=_clip(self.model_source))]
+        msg = DiagnosticArray(status=[status, model])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
 

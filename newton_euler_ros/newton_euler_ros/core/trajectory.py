@@ -1,0 +1,218 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Effort feedforward along a planned joint trajectory.
+
+joint_trajectory_controller (ros2_controllers >= 4.22, Jazzy) adds the
+``effort`` of each trajectory point as feedforward when the robot has an
+effort command interface; planners publish positions, velocities and
+accelerations but no efforts.  :func:`trajectory_efforts` fills them:
+tau = D qdd + C qd + g (+ J^T F_e) at every point, by one batched call.
+
+Points use the field names of ``trajectory_msgs/JointTrajectoryPoint``
+(``positions``, ``velocities``, ``accelerations``, ``effort``,
+``time_from_start`` in seconds).
+
+Missing derivatives.  ``velocities`` (or ``accelerations``) must be given
+in every point or in none.  When none has them they are the derivatives
+of the positions (of the velocities) at the given times, by second-order
+finite differences on the non-uniform grid (one-sided at the ends); a
+single point gets zeros.  Zeros would be wrong for a moving arm (the
+velocity-product and inertial torques would vanish), and the times are
+in the message, so differentiating is what the planner's curve implies.
+"""
+import math
+
+import numpy as np
+
+from .dynamics import inverse_dynamics_batch
+from .errors import DynamicsInputError
+
+MAX_POINTS = 100000
+FIELDS = ('positions', 'velocities', 'accelerations')
+
+
+class TrajectoryError(DynamicsInputError):
+    """A trajectory is unusable; the message says which point and field."""
+
+
+def differentiate(times, values):
+    """
+    Return d values / d t at each time, second order on a non-uniform grid.
+
+    ``times`` (m,) strictly increasing, ``values`` (m, n).  Interior points
+    use the three-point formula (exact for quadratics), the ends the
+    one-sided three-point formulas; two points give the slope, one zero.
+    """
+    t = np.asarray(times, dtype=np.float64)
+    x = np.asarray(values, dtype=np.float64)
+    m = t.shape[0]
+    out = np.zeros_like(x)
+    if m == 1:
+        return out
+    if m == 2:
+        out[:] = (x[1] - x[0]) / (t[1] - t[0])
+        return out
+    h0 = t[1:-1] - t[:-2]
+    h1 = t[2:] - t[1:-1]
+    out[1:-1] = ((-h1 / (h0 * (h0 + h1)))[:, None] * x[:-2]
+                 + ((h1 - h0) / (h0 * h1))[:, None] * x[1:-1]
+                 + (h0 / (h1 * (h0 + h1)))[:, None] * x[2:])
+    a, b = t[1] - t[0], t[2] - t[1]
+    out[0] = (-(2 * a + b) / (a * (a + b)) * x[0] + (a + b) / (a * b) * x[1]
+              - a / (b * (a + b)) * x[2])
+    a, b = t[-1] - t[-2], t[-2] - t[-3]
+    out[-1] = ((2 * a + b) / (a * (a + b)) * x[-1]
+               - (a + b) / (a * b) * x[-2] + a / (b * (a + b)) * x[-3])
+    return out
+
+
+def _column_map(model, joint_names, where):
+    names = list(joint_names)
+    if len(set(names)) != len(names):
+        dup = next(n for n in names if names.count(n) > 1)
+        raise TrajectoryError(f'{where}joint_names: {dup!r} appears twice')
+    unknown = [n for n in names if n not in model.joint_names]
+    if unknown:
+        raise TrajectoryError(f'{where}joint_names: unknown joints '
+                              f'{unknown[:5]} (the robot has '
+                              f'{list(model.joint_names)})')
+    missing = [n for n in model.joint_names if n not in names]
+    if missing:
+        raise TrajectoryError(f'{where}joint_names: missing joints '
+                              f'{missing[:5]}; every joint of the robot is '
+                              f'needed')
+    return np.array([names.index(n) for n in model.joint_names])
+
+
+def trajectory_arrays(model, joint_names, points, where=''):
+    """
+    Validate points; return (times, Q, QD, QDD) in the model's joint order.
+
+    ``points`` is a sequence of mappings (or objects with the same
+    attributes) with ``time_from_start`` and the three fields; ``where``
+    prefixes every error message (a file name, or the topic).
+    """
+    cols = _column_map(model, joint_names, where)
+    m = len(points)
+    if m == 0:
+        raise TrajectoryError(f'{where}points: the trajectory has no points')
+    if m > MAX_POINTS:
+        raise TrajectoryError(f'{where}points: {m} points, more than the '
+                              f'{MAX_POINTS} accepted')
+    n = len(cols)
+    times = np.empty(m)
+    arrays = {f: np.empty((m, n)) for f in FIELDS}
+    given = dict.fromkeys(FIELDS, 0)
+
+    def get(point, key):
+        if isinstance(point, dict):
+            return point.get(key)
+        return getattr(point, key, None)
+
+    for k, point in enumerate(points):
+        t = get(point, 'time_from_start')
+        try:
+            t = float(t)
+        except (TypeError, ValueError):
+            raise TrajectoryError(f'{where}points[{k}].time_from_start: must '
+                                  f'be a number of seconds, got {t!r}') \
+                from None
+        if not math.isfinite(t) or t < 0.0:
+            raise TrajectoryError(f'{where}points[{k}].time_from_start: must '
+                                  f'be finite and >= 0, got {t}')
+        if k and not t > times[k - 1]:
+            raise TrajectoryError(
+                f'{where}points[{k}].time_from_start: {t} s is not after '
+                f'the previous point ({times[k - 1]} s); times must increase')
+        times[k] = t
+        for field in FIELDS:
+            values = get(point, field)
+            if values is None or len(values) == 0:
+                continue
+            if len(values) != n:
+                raise TrajectoryError(
+                    f'{where}points[{k}].{field}: {len(values)} values for '
+                    f'{n} joints')
+            try:
+                row = np.asarray(values, dtype=np.float64)
+            except (TypeError, ValueError):
+                raise TrajectoryError(f'{where}points[{k}].{field}: must be '
+                                      f'numbers') from None
+            bad = np.flatnonzero(~np.isfinite(row))
+            if bad.size:
+                raise TrajectoryError(
+                    f'{where}points[{k}].{field}[{bad[0]}]: must be finite, '
+                    f'got {row[bad[0]]}')
+            arrays[field][k] = row[cols]
+            given[field] += 1
+    for field in FIELDS:
+        if given[field] not in (0, m):
+            raise TrajectoryError(
+                f'{where}points: {field} given in {given[field]} of {m} '
+                f'points; give them in every point or in none')
+    if not given['positions']:
+        raise TrajectoryError(f'{where}points: every point needs positions')
+    Q = arrays['positions']
+    QD = arrays['velocities'] if given['velocities'] else differentiate(
+        times, Q)
+    QDD = (arrays['accelerations'] if given['accelerations']
+           else differentiate(times, QD))
+    return times, Q, QD, QDD
+
+
+def trajectory_efforts(model, joint_names, points, wrench=None,
+                       wrench_frame='base', where='', ws=None):
+    """
+    Efforts (m, n) at every point, in the trajectory's joint order.
+
+    tau = D qdd + C qd + g (+ J^T F_e for a ``wrench`` held along the whole
+    trajectory), one batched call; raises :class:`TrajectoryError` for a
+    bad trajectory (one line naming the point and the field).
+    """
+    _, Q, QD, QDD = trajectory_arrays(model, joint_names, points, where)
+    W = None
+    if wrench is not None:
+        W = np.tile(np.asarray(wrench, dtype=np.float64), (Q.shape[0], 1))
+    tau = inverse_dynamics_batch(model, Q, QD, QDD, W, wrench_frame, ws=ws)
+    cols = _column_map(model, joint_names, where)
+    out = np.empty_like(tau)
+    out[:, cols] = tau
+    return out
+
+
+def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
+                 where=''):
+    """Return a JSON-style trajectory dict with ``effort`` in every point."""
+    names = trajectory.get('joint_names')
+    if not isinstance(names, list) or not all(isinstance(x, str)
+                                              for x in names):
+        raise TrajectoryError(f'{where}joint_names: must be a list of '
+                              f'strings')
+    points = trajectory.get('points')
+    if not isinstance(points, list) or not all(isinstance(p, dict)
+                                               for p in points):
+        raise TrajectoryError(f'{where}points: must be a list of objects')
+    for k, point in enumerate(points):
+        unknown = set(point) - {'time_from_start', 'effort', *FIELDS}
+        if unknown:
+            raise TrajectoryError(f'{where}points[{k}]: unknown key '
+                                  f'{sorted(unknown)[0]!r}')
+    efforts = trajectory_efforts(model, names, points, wrench, wrench_frame,
+                                 where)
+    out = dict(trajectory)
+    out['points'] = [dict(p, effort=e.tolist())
+                     for p, e in zip(points, efforts)]
+    return out
