@@ -33,6 +33,7 @@ Publishes
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
+import array
 import dataclasses
 import sys
 import threading
@@ -262,8 +263,7 @@ class InverseDynamicsNode(Node):
             else:
                 values[spec.name] = self.declare_parameter(
                     spec.name, spec.default, desc).value
-            if isinstance(values[spec.name], tuple):
-                values[spec.name] = list(values[spec.name])
+            values[spec.name] = _plain(values[spec.name])
         errors = validate(values, self.specs)
         if errors:
             raise ConfigurationError('; '.join(errors))
@@ -276,11 +276,7 @@ class InverseDynamicsNode(Node):
                            rigid_frames(model))
 
     def _on_set_parameters(self, params):
-        values = {}
-        for param in params:
-            values[param.name] = (list(param.value)
-                                  if isinstance(param.value, (tuple, list))
-                                  else param.value)
+        values = {param.name: _plain(param.value) for param in params}
         errors = validate(values, self.specs)
         if errors:
             return SetParametersResult(successful=False,
@@ -288,8 +284,7 @@ class InverseDynamicsNode(Node):
         current = {s.name: values.get(s.name,
                                       self.get_parameter(s.name).value)
                    for s in self.specs if s.name.startswith('wrench.')}
-        current = {k: list(v) if isinstance(v, tuple) else v
-                   for k, v in current.items()}
+        current = {k: _plain(v) for k, v in current.items()}
         payload = tuple(values.get(k, self.params[k]) for k in (
             'payload.mass', 'payload.com', 'payload.inertia'))
         ff = self.ff
@@ -493,6 +488,13 @@ class InverseDynamicsNode(Node):
         msg = DiagnosticArray(status=[status, model])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
+
+
+def _plain(value):
+    """A parameter value with arrays (tuple, array.array) as lists."""
+    if isinstance(value, (tuple, list, array.array)):
+        return list(value)
+    return value
 
 
 def _clip(text, limit=400):
