@@ -35,8 +35,8 @@ from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (end_effector_pose,  # noqa: E402
                                    gravity_torques, inverse_dynamics,
-                                   jacobian, load_robot, mass_matrix,
-                                   velocity_products, wrench_torques)
+                                   jacobian, load_robot, velocity_products,
+                                   wrench_torques)
 from rcl_interfaces.srv import (SetParameters,  # noqa: E402
                                 SetParametersAtomically)
 from rclpy.parameter import Parameter  # noqa: E402
@@ -200,7 +200,7 @@ def test_payload_set_at_run_time_adds_exactly_its_torques(gravity_graph,
     counters = g.probe.next_counters(g.diag)
     assert counters['payload_changes'] == 1
     model_status = g.diag[-1].status[1]
-    assert dict((kv.key, kv.value) for kv in model_status.values)[
+    assert {kv.key: kv.value for kv in model_status.values}[
         'payload.mass'] == '2.0'
 
 

@@ -491,7 +491,7 @@ class InverseDynamicsNode(Node):
 
 
 def _plain(value):
-    """A parameter value with arrays (tuple, array.array) as lists."""
+    """Return a parameter value with arrays (tuple, array.array) as lists."""
     if isinstance(value, (tuple, list, array.array)):
         return list(value)
     return value
