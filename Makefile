@@ -41,6 +41,7 @@ bench: setup
 	$(PY) -m newton_euler_ros.bench
 	$(PY) -m newton_euler_ros.bench_effects
 	$(PY) -m newton_euler_ros.bench_urdf
+	$(PY) -m newton_euler_ros.bench_trajectory
 
 latency: setup
 	$(PY) -m newton_euler_ros.latency_bench

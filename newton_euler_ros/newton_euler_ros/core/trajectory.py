@@ -97,33 +97,53 @@ def _column_map(model, joint_names, where):
     return np.array([names.index(n) for n in model.joint_names])
 
 
-def trajectory_arrays(model, joint_names, points, where=''):
-    """
-    Validate points; return (times, Q, QD, QDD) in the model's joint order.
+def _get(point, key):
+    if isinstance(point, dict):
+        return point.get(key)
+    return getattr(point, key, None)
 
-    ``points`` is a sequence of mappings (or objects with the same
-    attributes) with ``time_from_start`` and the three fields; ``where``
-    prefixes every error message (a file name, or the topic).
+
+def _vectorized(points, n, cols):
     """
-    cols = _column_map(model, joint_names, where)
+    The arrays of well-formed points in a few numpy calls, else None.
+
+    A trajectory from a planner is almost always well formed; checking it
+    with whole-array operations keeps the per-point cost near the
+    dynamics' own.  Anything unusual returns None, and the point-by-point
+    check then names the problem.
+    """
+    try:
+        times = np.array([_get(p, 'time_from_start') for p in points],
+                         dtype=np.float64)
+        if not np.isfinite(times).all() or times[0] < 0.0 or (
+                times.shape[0] > 1 and not (np.diff(times) > 0.0).all()):
+            return None
+        arrays, given = {}, {}
+        for field in FIELDS:
+            rows = [_get(p, field) for p in points]
+            sizes = {0 if r is None else len(r) for r in rows}
+            if sizes == {0}:
+                arrays[field], given[field] = None, 0
+                continue
+            if sizes != {n}:
+                return None
+            X = np.array(rows, dtype=np.float64)
+            if X.shape != (len(points), n) or not np.isfinite(X).all():
+                return None
+            arrays[field], given[field] = X[:, cols], len(points)
+        return times, arrays, given
+    except (TypeError, ValueError):
+        return None
+
+
+def _point_by_point(points, n, cols, where):
+    """The same arrays, checked one point at a time; errors name the point."""
     m = len(points)
-    if m == 0:
-        raise TrajectoryError(f'{where}points: the trajectory has no points')
-    if m > MAX_POINTS:
-        raise TrajectoryError(f'{where}points: {m} points, more than the '
-                              f'{MAX_POINTS} accepted')
-    n = len(cols)
     times = np.empty(m)
     arrays = {f: np.empty((m, n)) for f in FIELDS}
     given = dict.fromkeys(FIELDS, 0)
-
-    def get(point, key):
-        if isinstance(point, dict):
-            return point.get(key)
-        return getattr(point, key, None)
-
     for k, point in enumerate(points):
-        t = get(point, 'time_from_start')
+        t = _get(point, 'time_from_start')
         try:
             t = float(t)
         except (TypeError, ValueError):
@@ -139,7 +159,7 @@ def trajectory_arrays(model, joint_names, points, where=''):
                 f'the previous point ({times[k - 1]} s); times must increase')
         times[k] = t
         for field in FIELDS:
-            values = get(point, field)
+            values = _get(point, field)
             if values is None or len(values) == 0:
                 continue
             if len(values) != n:
@@ -158,6 +178,33 @@ def trajectory_arrays(model, joint_names, points, where=''):
                     f'got {row[bad[0]]}')
             arrays[field][k] = row[cols]
             given[field] += 1
+    for field in FIELDS:
+        if given[field] == 0:
+            arrays[field] = None
+    return times, arrays, given
+
+
+def trajectory_arrays(model, joint_names, points, where=''):
+    """
+    Validate points; return (times, Q, QD, QDD) in the model's joint order.
+
+    ``points`` is a sequence of mappings (or objects with the same
+    attributes) with ``time_from_start`` and the three fields; ``where``
+    prefixes every error message (a file name, or the topic).
+    """
+    cols = _column_map(model, joint_names, where)
+    m = len(points)
+    if m == 0:
+        raise TrajectoryError(f'{where}points: the trajectory has no points')
+    if m > MAX_POINTS:
+        raise TrajectoryError(f'{where}points: {m} points, more than the '
+                              f'{MAX_POINTS} accepted')
+    n = len(cols)
+    fast = _vectorized(points, n, cols)
+    if fast is not None:
+        times, arrays, given = fast
+    else:       # something is off: find it point by point, for the message
+        times, arrays, given = _point_by_point(points, n, cols, where)
     for field in FIELDS:
         if given[field] not in (0, m):
             raise TrajectoryError(
