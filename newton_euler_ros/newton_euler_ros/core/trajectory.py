@@ -105,7 +105,7 @@ def _get(point, key):
 
 def _vectorized(points, n, cols):
     """
-    The arrays of well-formed points in a few numpy calls, else None.
+    Return the arrays of well-formed points in a few numpy calls, or None.
 
     A trajectory from a planner is almost always well formed; checking it
     with whole-array operations keeps the per-point cost near the
@@ -137,7 +137,7 @@ def _vectorized(points, n, cols):
 
 
 def _point_by_point(points, n, cols, where):
-    """The same arrays, checked one point at a time; errors name the point."""
+    """Return the same arrays, checked point by point (errors name it)."""
     m = len(points)
     times = np.empty(m)
     arrays = {f: np.empty((m, n)) for f in FIELDS}
