@@ -2,6 +2,7 @@
 #   make setup   create/refresh .venv (idempotent; < 2 s when up to date)
 #   make test    set up if needed, then run pytest over newton_euler_ros/test
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
+#   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
 #   make accuracy  accuracy-vs-time report -> docs/accuracy-vs-time.md (+ peers)
@@ -25,7 +26,7 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
 
-.PHONY: setup test demo bench latency peers accuracy accuracy-quick \
+.PHONY: setup test demo demo-pick bench latency peers accuracy accuracy-quick \
 	colcon-check clean
 
 setup:
@@ -36,6 +37,9 @@ test: setup
 
 demo: setup
 	$(PY) -m newton_euler_ros.demo
+
+demo-pick: setup
+	$(PY) -m newton_euler_ros.demo_pick
 
 bench: setup
 	$(PY) -m newton_euler_ros.bench

@@ -263,3 +263,57 @@ def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
     out['points'] = [dict(p, effort=e.tolist())
                      for p, e in zip(points, efforts)]
     return out
+
+
+class TrajectoryFollower:
+    """
+    What joint_trajectory_controller does with a trajectory, as a sampler.
+
+    Holds the trajectories received (each anchored at its absolute start
+    time); :meth:`sample` returns the desired positions, velocities and
+    efforts at time t from the newest trajectory that has started, linear
+    in time between its points (JTC interpolates with splines; at the
+    10 ms spacing of a planner's points the difference is negligible
+    here), holding the last point after its end.  Efforts default to
+    zero when the points have none.  The simulator uses it to stand in
+    for JTC with an effort command interface: tau = kp (q_d - q) +
+    kd (qd_d - qd) + effort_d.
+    """
+
+    def __init__(self, model, keep=8):
+        self.model = model
+        self.keep = keep
+        self.trajectories = []      # (start, times, Q, QD, EFF)
+
+    def set(self, joint_names, start, points):  # noqa: A003 (JTC's verb)
+        """Add a trajectory starting at ``start`` (s); raises on bad input."""
+        times, Q, QD, _ = trajectory_arrays(self.model, joint_names, points)
+        cols = _column_map(self.model, joint_names, '')
+        eff = np.zeros_like(Q)
+        efforts = [p.get('effort') if isinstance(p, dict)
+                   else getattr(p, 'effort', None) for p in points]
+        if all(e is not None and len(e) == len(cols) for e in efforts):
+            eff = np.asarray(efforts, dtype=np.float64)[:, cols]
+            if not np.isfinite(eff).all():
+                raise TrajectoryError('effort: must be finite')
+        self.trajectories.append((float(start), times, Q, QD, eff))
+        self.trajectories.sort(key=lambda tr: tr[0])
+        del self.trajectories[:-self.keep]
+
+    def sample(self, t):
+        """Desired (q, qd, effort) at time t, or None before any start."""
+        active = None
+        for tr in self.trajectories:
+            if tr[0] <= t:
+                active = tr
+        if active is None:
+            return None
+        start, times, Q, QD, eff = active
+        s = t - start
+        if s <= times[0]:
+            return Q[0], QD[0], eff[0]
+        if s >= times[-1]:
+            return Q[-1], np.zeros_like(QD[-1]), eff[-1]
+        k = int(np.searchsorted(times, s, side='right'))
+        w = (s - times[k - 1]) / (times[k] - times[k - 1])
+        return tuple((1.0 - w) * X[k - 1] + w * X[k] for X in (Q, QD, eff))

@@ -86,7 +86,14 @@ def run_node(make_node, name, args=None):
         executor = make_executor()
         executor.add_node(node)
         while rclpy.ok():
-            executor.spin_once(timeout_sec=0.1)
+            try:
+                executor.spin_once(timeout_sec=0.1)
+            except Exception:
+                if rclpy.ok():
+                    raise
+                # SIGINT shut the context down while a callback was still
+                # publishing: that is the stop we were asked for
+                break
     except ConfigurationError as exc:
         print(f'{name}: invalid parameters: {exc}', file=sys.stderr)
         code = 2

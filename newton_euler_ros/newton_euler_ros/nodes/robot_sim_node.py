@@ -21,7 +21,8 @@ scene's integrator step, holding the last torque command (zero-order
 hold), then publishes the state.  Simulated time t maps onto the
 wall-clock stamp ``start + t``; ``~/start`` (latched) carries ``start``
 so that controllers can align their reference.  Once a publisher on
-``~/commands`` exists (``wait_for_controller``) and joint_states has
+``~/commands`` or ``~/joint_trajectory`` exists (``wait_for_controller``)
+and joint_states has
 ``wait_for_subscribers`` matched subscribers, ``start`` is announced
 LEAD seconds ahead, so that the controller and the inverse-dynamics node
 have the reference (and the wrench) before t = 0; and t = 0 is held
@@ -31,29 +32,44 @@ start with a period at zero torque.  Stamps then run that much behind the
 wall clock.  The simulation stops advancing after the scene's duration,
 still publishing.
 
+A stand-in for joint_trajectory_controller with an effort command
+interface: a ``JointTrajectory`` on ``~/joint_trajectory`` (stamped on
+this node's timeline, ``start + t``; zero stamp: now) takes over from
+``~/commands`` once it starts, commanding kp (q_d - q) + kd (qd_d - qd)
++ effort_d with the scene's gains at every control period.  The plant's
+payload (``payload.mass``, ``payload.com``, ``payload.inertia``) can be
+changed at run time: picking up an object.
+
 Subscribes
-    ~/commands (std_msgs/Float64MultiArray: n torques, the model's order)
+    ~/commands (std_msgs/Float64MultiArray: n torques, the model's order),
+    ~/joint_trajectory (trajectory_msgs/JointTrajectory)
 Publishes
     joint_states (sensor_msgs/JointState, effort = applied torque),
     wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),
     ~/start (std_msgs/Header, transient local)
 """
+import array
+import dataclasses
 import math
 import sys
 import time
 
 from geometry_msgs.msg import WrenchStamped
 import numpy as np
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.time import Time
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
+from trajectory_msgs.msg import JointTrajectory
 
 from .common import ConfigurationError, declare, qos_profile, run_node
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
 from ..core.simulate import integrator_step, SceneDynamics
+from ..core.trajectory import TrajectoryFollower
+from ..feedforward import payload_model
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -105,6 +121,21 @@ class RobotSimNode(Node):
             raise ConfigurationError(f'scene: {exc}') from None
         scene = self.scene
         self.dyn = SceneDynamics(scene)
+        self.payload = (
+            declare(self, 'payload.mass', 0.0, 'Payload the plant picks up '
+                    '(kg), fixed to the end effector; settable at run '
+                    'time.'),
+            declare(self, 'payload.com', [0.0, 0.0, 0.0], 'Its centre of '
+                    'mass in the end-effector frame (m).'),
+            declare(self, 'payload.inertia', [0.0] * 6, 'Its inertia about '
+                    'the centre of mass, [Ixx, Iyy, Izz, Ixy, Iyz, Ixz] in '
+                    'end-effector axes (kg m^2).'))
+        try:
+            self.dyn = self._plant(self.payload)
+        except ValueError as exc:
+            raise ConfigurationError(str(exc)) from None
+        self.follower = TrajectoryFollower(scene.model)
+        self.commands = 0            # commands received on ~/commands
         n = scene.model.n
         self.q = scene.q0.astype(float).copy()
         self.qd = scene.qd0.astype(float).copy()
@@ -142,6 +173,9 @@ class RobotSimNode(Node):
         self.start_pub = self.create_publisher(Header, '~/start', latched)
         self.create_subscription(Float64MultiArray, '~/commands',
                                  self._on_command, qos)
+        self.create_subscription(JointTrajectory, '~/joint_trajectory',
+                                 self._on_trajectory, 10)
+        self.add_on_set_parameters_callback(self._on_set_parameters)
         self._state = JointState()
         self._state.name = list(scene.model.joint_names)
         self._wrench = WrenchStamped()
@@ -170,11 +204,16 @@ class RobotSimNode(Node):
             return
         self.tau = data
         self.commanded = True
+        self.commands += 1
 
     def _ready(self):
         if not self.wait:
             return True
-        if (self.count_publishers(self.resolve_topic_name('~/commands')) < 1
+        controllers = (
+            self.count_publishers(self.resolve_topic_name('~/commands'))
+            + self.count_publishers(
+                self.resolve_topic_name('~/joint_trajectory')))
+        if (controllers < 1
                 or self.state_pub.get_subscription_count()
                 < self.subscribers):
             self.ready_since = None
@@ -220,7 +259,7 @@ class RobotSimNode(Node):
             self.ticks += 1
             t_next = self.ticks * self.period
             if t_next <= self.scene.duration + 1e-9:
-                tau = self.tau
+                tau = self._trajectory_command()
                 self.q, self.qd = advance(self.dyn, self.q, self.qd, tau,
                                           self.t, self.period,
                                           self.scene.step,
@@ -236,6 +275,57 @@ class RobotSimNode(Node):
         msg.velocity = self.qd.tolist()
         msg.effort = self.applied.tolist()
         self.state_pub.publish(msg)
+
+    def _plant(self, payload):
+        """Scene dynamics with a payload on the end effector."""
+        model = payload_model(self.scene.model, *payload)
+        return SceneDynamics(dataclasses.replace(self.scene, model=model))
+
+    def _on_set_parameters(self, params):
+        values = {p.name: (list(p.value) if isinstance(
+            p.value, (tuple, list, array.array)) else p.value)
+            for p in params}
+        keys = ('payload.mass', 'payload.com', 'payload.inertia')
+        if not any(k in values for k in keys):
+            return SetParametersResult(successful=True)
+        payload = tuple(values.get(k, old)
+                        for k, old in zip(keys, self.payload))
+        try:
+            dyn = self._plant(payload)
+        except (ValueError, TypeError) as exc:
+            return SetParametersResult(successful=False, reason=str(exc))
+        self.dyn, self.payload = dyn, payload
+        self.get_logger().info(f'plant payload now {payload[0]} kg at '
+                               f'{list(payload[1])} m, t = {self.t:.3f} s')
+        return SetParametersResult(successful=True)
+
+    def _on_trajectory(self, msg):
+        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        if stamp == 0.0:
+            stamp = self.get_clock().now().nanoseconds * 1e-9
+        try:
+            points = [{'time_from_start': p.time_from_start.sec
+                       + p.time_from_start.nanosec * 1e-9,
+                       'positions': p.positions, 'velocities': p.velocities,
+                       'effort': p.effort} for p in msg.points]
+            self.follower.set(msg.joint_names, stamp, points)
+            self.commanded = True
+        except NewtonEulerError as exc:
+            self.dropped += 1
+            self.get_logger().warning(f'dropped trajectory: {exc}'[:400],
+                                      throttle_duration_sec=2.0)
+
+    def _trajectory_command(self):
+        """JTC stand-in: PD on the active trajectory plus its effort."""
+        if self.start_ns is None:
+            return self.tau
+        t = (self.start_ns * 1e-9) + self.t
+        desired = self.follower.sample(t)
+        if desired is None:
+            return self.tau
+        q_d, qd_d, eff = desired
+        sc = self.scene
+        return sc.kp * (q_d - self.q) + sc.kd * (qd_d - self.qd) + eff
 
     def _on_wrench(self, msg):
         """
