@@ -26,7 +26,10 @@
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
 (``.urdf``, with ``--base LINK --tip LINK`` to choose the chain).  Every
-error is one line on stderr and a non-zero exit status.
+error is one line on stderr.  Exit status: 0 done; 1 an input is unusable
+(a robot, scene, states or trajectory file, or a value in it); 2 the
+command line is wrong (unknown command or option, missing or malformed
+argument); 130 interrupted.
 """
 import argparse
 import json
@@ -36,18 +39,37 @@ import numpy as np
 
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError)
-from .core.robot_file import bundled_robots, to_number
+from .core.robot_file import bundled_robots, Note, read_text, to_number
 
 EXIT_USAGE = 2
 EXIT_ERROR = 1
+MAX_JSON_BYTES = 64 * 1024 * 1024
 
 
 class CliError(Exception):
-    """A user error, printed as one line."""
+    """A command-line error, printed as one line (exit status 2)."""
+
+
+class InputError(NewtonEulerError):
+    """An input file or value is unusable (exit status 1)."""
+
+
+def _read_json(path):
+    """Parse a JSON file; every failure is one line naming it."""
+    text = read_text(path, MAX_JSON_BYTES, 'JSON file')
+    try:
+        return json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f'{path}: not valid JSON: {exc}') from None
+    except RecursionError:
+        raise InputError(f'{path}: nested too deeply') from None
 
 
 def _numbers(values, option):
-    return [to_number(v, option) for v in values]
+    try:
+        return [to_number(v, option) for v in values]
+    except NewtonEulerError as exc:     # a malformed argument: usage
+        raise CliError(str(exc)) from None
 
 
 def _state_vector(values, n, option):
@@ -74,24 +96,18 @@ def evaluate(model, q, qd, qdd, wrench, wrench_frame):
 
 
 def _load_states(path, n):
-    try:
-        with open(path, encoding='utf-8') as fh:
-            states = json.load(fh)
-    except OSError as exc:
-        raise CliError(f'{path}: cannot read: {exc.strerror}') from None
-    except json.JSONDecodeError as exc:
-        raise CliError(f'{path}: not valid JSON: {exc}') from None
+    states = _read_json(path)
     if not isinstance(states, list):
-        raise CliError(f'{path}: must hold a JSON list of states')
+        raise InputError(f'{path}: must hold a JSON list of states')
     out = []
     for i, st in enumerate(states):
         if not isinstance(st, dict):
-            raise CliError(f'{path}: state {i}: must be an object with '
-                           f'"q", "qd", "qdd", "wrench"')
+            raise InputError(f'{path}: state {i}: must be an object with '
+                             f'"q", "qd", "qdd", "wrench"')
         unknown = set(st) - {'q', 'qd', 'qdd', 'wrench'}
         if unknown:
-            raise CliError(f'{path}: state {i}: unknown key '
-                           f'{sorted(unknown)[0]!r}')
+            raise InputError(f'{path}: state {i}: unknown key '
+                             f'{sorted(unknown)[0][:200]!r}')
         vecs = {}
         for key, size in (('q', n), ('qd', n), ('qdd', n), ('wrench', 6)):
             value = st.get(key)
@@ -99,8 +115,8 @@ def _load_states(path, n):
                 vecs[key] = np.zeros(size)
                 continue
             if not isinstance(value, list) or len(value) != size:
-                raise CliError(f'{path}: state {i}: {key}: must be a list of '
-                               f'{size} numbers')
+                raise InputError(f'{path}: state {i}: {key}: must be a list '
+                                 f'of {size} numbers')
             vecs[key] = np.array(_numbers(value, f'{path}: state {i}: {key}'))
         out.append(vecs)
     return out
@@ -112,9 +128,11 @@ def _fmt(x, width=13):
 
 def _matrix_lines(title, names, M, col_names=None):
     col_names = col_names or names
-    lines = [title, ' ' * 14 + ''.join(f'{c[:12]:>13}' for c in col_names)]
+    w = max(12, *(len(x) for x in names))       # names are never cut
+    cw = max(13, *(len(c) + 1 for c in col_names))
+    lines = [title, ' ' * (w + 2) + ''.join(f'{c:>{cw}}' for c in col_names)]
     for name, row in zip(names, M):
-        lines.append(f'  {name[:12]:<12}' + ''.join(_fmt(v) for v in row))
+        lines.append(f'  {name:<{w}}' + ''.join(_fmt(v, cw) for v in row))
     return lines
 
 
@@ -124,6 +142,13 @@ def _source(model):
     report = model.info.get('urdf', {})
     return (f'URDF chain {report.get("base", "?")} -> '
             f'{report.get("tip", "?")}')
+
+
+def _warn(found):
+    """Print warnings; notes about published data are for ``check``."""
+    for message in found:
+        if not isinstance(message, Note):
+            print(f'warning: {message}', file=sys.stderr)
 
 
 def _load(args):
@@ -146,13 +171,14 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
     lines.append('')
     head = ('joint', 'type', 'q', 'qd', 'qdd', 'D qdd', 'C qd', 'g',
             'J^T F', 'tau')
-    lines.append(f'{head[0]:<12}{head[1]:<10}' + ''.join(f'{h:>13}'
-                                                         for h in head[2:]))
+    w = max(12, *(len(x) + 1 for x in names))  # names are never cut
+    lines.append(f'{head[0]:<{w}}{head[1]:<10}' + ''.join(f'{h:>13}'
+                                                          for h in head[2:]))
     for j, name in enumerate(names):
         unit = 'N m' if model.joint_types[j] == 'revolute' else 'N'
         row = (q[j], qd[j], qdd[j], (D @ qdd)[j], (C @ qd)[j], g[j], jtf[j],
                result['tau'][j])
-        lines.append(f'{name[:11]:<12}{model.joint_types[j][:9]:<10}'
+        lines.append(f'{name:<{w}}{model.joint_types[j][:9]:<10}'
                      + ''.join(_fmt(v) for v in row) + f'  {unit}')
     lines.append('tau = D qdd + C qd + g + J^T F  (N m for revolute, '
                  'N for prismatic joints)')
@@ -170,8 +196,7 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
 
 def cmd_dynamics(args):
     model, found, _ = _load(args)
-    for message in found:
-        print(f'warning: {message}', file=sys.stderr)
+    _warn(found)
     n = model.n
     if args.states:
         if any(v is not None for v in (args.q, args.qd, args.qdd,
@@ -224,9 +249,10 @@ def cmd_check(args):
               f'{", ".join(report["continuous"]) or "none"}')
     print(f'  total mass: {model.total_mass:.6g} kg')
     print(f'  gravity: {model.gravity.tolist()} m/s^2')
-    print(f'  warnings: {len(found)}')
+    notes = [m for m in found if isinstance(m, Note)]
+    print(f'  warnings: {len(found) - len(notes)}')
     for message in found:
-        print(f'  warning: {message}')
+        print(f'  {"note" if message in notes else "warning"}: {message}')
     return 0
 
 
@@ -234,8 +260,7 @@ def cmd_simulate(args):
     from .core.scene import load_scene
     from .core.simulate import simulate
     scene = load_scene(args.scene)
-    for message in scene.warnings:
-        print(f'warning: {message}', file=sys.stderr)
+    _warn(scene.warnings)
     if args.duration is not None and not args.duration > 0.0:
         raise CliError(f'--duration must be > 0, got {args.duration}')
     result = simulate(scene, duration=args.duration,
@@ -267,19 +292,12 @@ def cmd_simulate(args):
 def cmd_feedforward(args):
     from .core.trajectory import fill_efforts
     model, found, _ = _load(args)
-    for message in found:
-        print(f'warning: {message}', file=sys.stderr)
+    _warn(found)
     path = args.trajectory
-    try:
-        with open(path, encoding='utf-8') as fh:
-            trajectory = json.load(fh)
-    except OSError as exc:
-        raise CliError(f'{path}: cannot read: {exc.strerror}') from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise CliError(f'{path}: not valid JSON: {exc}') from None
+    trajectory = _read_json(path)
     if not isinstance(trajectory, dict):
-        raise CliError(f'{path}: must hold a JSON object with "joint_names"'
-                       f' and "points"')
+        raise InputError(f'{path}: must hold a JSON object with '
+                         f'"joint_names" and "points"')
     wrench = (np.array(_numbers(args.wrench, '--wrench'))
               if args.wrench is not None else None)
     print(json.dumps(fill_efforts(model, trajectory, wrench,
@@ -290,16 +308,15 @@ def cmd_feedforward(args):
 def cmd_urdf(args):
     from .core.urdf import model_to_urdf
     model, found, _ = _load(args)
-    for message in found:
-        print(f'warning: {message}', file=sys.stderr)
+    _warn(found)
     text = model_to_urdf(model)
     if args.output:
         try:
             with open(args.output, 'w', encoding='utf-8') as fh:
                 fh.write(text)
         except OSError as exc:
-            raise CliError(f'{args.output}: cannot write: '
-                           f'{exc.strerror}') from None
+            raise InputError(f'{args.output}: cannot write: '
+                             f'{exc.strerror}') from None
     else:
         sys.stdout.write(text)
     return 0

@@ -44,6 +44,15 @@ LIMIT_KEYS = {'lower', 'upper', 'velocity', 'effort'}
 POSE_KEYS = {'xyz', 'rpy'}
 
 
+class Note(str):
+    """
+    A warning about published data that is accepted as published.
+
+    ``newton-euler check`` and the node's start-up log show notes; the
+    other commands do not repeat them on every use.
+    """
+
+
 class RobotFileWarning(UserWarning):
     """A robot file is accepted but something in it is suspicious."""
 
@@ -73,18 +82,64 @@ def resolve_robot_path(name_or_path):
     path = os.fspath(name_or_path)
     if os.path.isfile(path):
         return path
+    if os.path.isdir(path):
+        raise RobotFileError(f'{_short(path)}: is a directory, not a robot '
+                             f'file')
     if os.sep not in path and not path.endswith(('.yaml', '.yml')):
         for folder in bundled_dirs():
             candidate = os.path.join(folder, path + '.yaml')
             if os.path.isfile(candidate):
                 return candidate
     raise RobotFileError(
-        f'{path}: no such file, and not a bundled robot '
+        f'{_short(path)}: no such file, and not a bundled robot '
         f'(bundled: {", ".join(bundled_robots()) or "none found"})')
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """SafeLoader that rejects a key given twice in one mapping."""
+MAX_FILE_BYTES = 1024 * 1024     # robot and scene files are a few kB
+MAX_DEPTH = 32                   # they nest 4 levels deep
+
+
+class _Clipped(str):
+    """A clipped repr that prints as itself under ``!r`` and ``str``."""
+
+    def __repr__(self):
+        return str(self)
+
+
+def _short(value, limit=200):
+    """Return value, or its repr clipped to ``limit`` characters."""
+    text = repr(value)
+    if len(text) <= limit:
+        return value
+    return _Clipped(text[:limit] + '...')
+
+
+class _SafeLoader(yaml.SafeLoader):
+    """
+    SafeLoader for files from people and networks.
+
+    Rejects a key given twice in one mapping, anchors and aliases (a robot
+    file has no use for them, and they are how a few bytes expand into
+    gigabytes) and nesting deeper than MAX_DEPTH (which would otherwise
+    end in a RecursionError).
+    """
+
+    def compose_node(self, parent, index):
+        event = self.peek_event()
+        if isinstance(event, yaml.AliasEvent) or getattr(
+                event, 'anchor', None) is not None:
+            raise yaml.constructor.ConstructorError(
+                None, None, 'anchors and aliases (& and *) are not '
+                'accepted', event.start_mark)
+        self._depth = getattr(self, '_depth', 0) + 1
+        try:
+            if self._depth > MAX_DEPTH:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f'nested more than {MAX_DEPTH} levels deep',
+                    event.start_mark)
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
 
 
 def _construct_mapping(loader, node, deep=False):
@@ -93,31 +148,69 @@ def _construct_mapping(loader, node, deep=False):
         key = loader.construct_object(key_node, deep=deep)
         if key in seen:
             raise yaml.constructor.ConstructorError(
-                None, None, f'key {key!r} appears twice',
+                None, None, f'key {_short(key)!r} appears twice',
                 key_node.start_mark)
         seen.add(key)
     return loader.construct_mapping(node, deep)
 
 
-_UniqueKeyLoader.add_constructor(
+_SafeLoader.add_constructor(
     yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+
+
+def read_text(path, max_bytes=MAX_FILE_BYTES, what='file'):
+    """
+    Read a UTF-8 text file; every failure is a one-line RobotFileError.
+
+    Refuses a directory, a file larger than ``max_bytes`` (without reading
+    it), an empty file and bytes that are not UTF-8.
+    """
+    label = _short(path)
+    if os.path.isdir(path):
+        raise RobotFileError(f'{label}: is a directory, not a {what}')
+    try:
+        size = os.path.getsize(path)
+        if size > max_bytes:
+            raise RobotFileError(f'{label}: {size} bytes, more than the '
+                                 f'{max_bytes} accepted for a {what}')
+        with open(path, 'rb') as fh:
+            data = fh.read(max_bytes + 1)
+    except OSError as exc:
+        raise RobotFileError(f'{label}: cannot read: {exc.strerror}') \
+            from None
+    if len(data) > max_bytes:
+        raise RobotFileError(f'{label}: more than the {max_bytes} bytes '
+                             f'accepted for a {what}')
+    try:
+        text = data.decode('utf-8')
+    except UnicodeDecodeError as exc:
+        raise RobotFileError(f'{label}: not UTF-8 text (byte {exc.start}); '
+                             f'is it a {what}?') from None
+    if not text.strip():
+        raise RobotFileError(f'{label}: the file is empty')
+    return text
 
 
 def read_yaml(path):
     """Parse a YAML file, with errors that name the file and the line."""
+    text = read_text(path, what='YAML file')
     try:
-        with open(path, encoding='utf-8') as fh:
-            return yaml.load(fh, Loader=_UniqueKeyLoader)
-    except OSError as exc:
-        raise RobotFileError(f'{path}: cannot read: {exc.strerror}') from None
+        data = yaml.load(text, Loader=_SafeLoader)
     except yaml.YAMLError as exc:
         where = ''
         mark = getattr(exc, 'problem_mark', None)
         if mark is not None:
             where = f' (line {mark.line + 1}, column {mark.column + 1})'
         problem = getattr(exc, 'problem', None) or str(exc)
-        raise RobotFileError(f'{path}: not valid YAML{where}: {problem}') \
-            from None
+        raise RobotFileError(f'{_short(path)}: not valid YAML{where}: '
+                             f'{_short(problem)}') from None
+    except RecursionError:      # belt and braces: the loader caps depth
+        raise RobotFileError(f'{_short(path)}: nested too deeply') from None
+    if not isinstance(data, dict):
+        raise RobotFileError(f'{_short(path)}: must be a mapping of keys '
+                             f'(name, links, ...), not a '
+                             f'{type(data).__name__}')
+    return data
 
 
 _OPS = {ast.Add: operator.add, ast.Sub: operator.sub,
@@ -144,7 +237,7 @@ def _eval_expr(node):
 def to_number(value, where):
     """Return a finite float from a YAML value; raise RobotFileError naming where."""
     if isinstance(value, bool) or value is None:
-        raise RobotFileError(f'{where}: must be a number, got {value!r}')
+        raise RobotFileError(f'{where}: must be a number, got {_short(value)!r}')
     if isinstance(value, (int, float)):
         result = float(value)
     elif isinstance(value, str):
@@ -158,13 +251,13 @@ def to_number(value, where):
                     RecursionError):
                 raise RobotFileError(
                     f'{where}: must be a number (or an expression of pi '
-                    f'like "-pi/2"), got {value!r}') from None
+                    f'like "-pi/2"), got {_short(value)!r}') from None
     else:
         raise RobotFileError(
             f'{where}: must be a number, got {type(value).__name__} '
-            f'{value!r}')
+            f'{_short(value)!r}')
     if not math.isfinite(result):
-        raise RobotFileError(f'{where}: must be finite, got {value!r}')
+        raise RobotFileError(f'{where}: must be finite, got {_short(value)!r}')
     return result
 
 
@@ -172,7 +265,7 @@ def to_vector(value, size, where):
     """Return a YAML list of ``size`` numbers as a list of finite floats."""
     if not isinstance(value, (list, tuple)):
         raise RobotFileError(
-            f'{where}: must be a list of {size} numbers, got {value!r}')
+            f'{where}: must be a list of {size} numbers, got {_short(value)!r}')
     if len(value) != size:
         raise RobotFileError(
             f'{where}: must have {size} entries, got {len(value)}')
@@ -181,11 +274,11 @@ def to_vector(value, size, where):
 
 def _check_keys(data, allowed, where):
     if not isinstance(data, dict):
-        raise RobotFileError(f'{where}: must be a mapping, got {data!r}')
+        raise RobotFileError(f'{where}: must be a mapping, got {_short(data)!r}')
     unknown = sorted(set(map(str, data)) - allowed)
     if unknown:
         raise RobotFileError(
-            f'{where}: unknown key {unknown[0]!r} '
+            f'{where}: unknown key {_short(unknown[0])!r} '
             f'(allowed: {", ".join(sorted(allowed))})')
 
 
@@ -248,7 +341,7 @@ def robot_from_dict(data, origin='<robot>'):
     if convention not in (STANDARD, MODIFIED):
         raise RobotFileError(
             f"{origin}: convention: must be 'standard' or 'modified', "
-            f'got {convention!r}')
+            f'got {_short(convention)!r}')
     gravity = to_vector(data.get('gravity', [0.0, 0.0, -9.81]), 3,
                         f'{origin}: gravity')
     base = _pose(data['base'], f'{origin}: base') if 'base' in data else None
@@ -270,13 +363,13 @@ def robot_from_dict(data, origin='<robot>'):
             raise RobotFileError(f'{where}: name: must be a non-empty string')
         if jname in cols['joint_names']:
             raise RobotFileError(
-                f'{where}: name: {jname!r} is used by an earlier link; '
+                f'{where}: name: {_short(jname)!r} is used by an earlier link; '
                 f'joint names must be unique')
         jtype = link['type']
         if jtype not in (REVOLUTE, PRISMATIC):
             raise RobotFileError(
                 f"{where}: type: must be 'revolute' or 'prismatic', "
-                f'got {jtype!r}')
+                f'got {_short(jtype)!r}')
         cols['joint_names'].append(jname)
         cols['joint_types'].append(jtype)
         for key in ('a', 'alpha', 'd'):
@@ -293,11 +386,11 @@ def robot_from_dict(data, origin='<robot>'):
         cols['inertia'].append(inertia)
         tol = 1e-9 * max(eig[2], 1e-300)
         if eig[0] + eig[1] < eig[2] - tol:
-            found.append(
+            found.append(Note(
                 f'{where}: inertia: principal moments '
                 f'{eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} break the '
                 f'triangle inequality (no real body has them); accepted '
-                f'as published')
+                f'as published'))
         if mass == 0.0 and any(c != 0.0 for c in com):
             found.append(f'{where}: com: given for a link of zero mass; '
                          f'it has no effect')
@@ -306,6 +399,48 @@ def robot_from_dict(data, origin='<robot>'):
     model = make_model(name=name, convention=convention, gravity=gravity,
                        base=base, tool=tool, **cols)
     return model, found
+
+
+def singular_joint_warning(model, origin, samples=3, seed=0):
+    """
+    Return a warning when D(q) is singular everywhere (naming the joint).
+
+    D loses rank when the links from some joint to the tip carry no mass
+    or inertia that the joint can move (a massless tail, a zero-inertia
+    last link on a revolute joint).  Inverse dynamics still works; forward
+    dynamics, the simulator and ``check``'s condition number cannot.
+    Tested at a few random configurations (singular at all of them, not
+    at an isolated pose).
+    """
+    from .dynamics import mass_matrix
+    from .errors import DynamicsInputError
+    rng = np.random.default_rng(seed)
+    joints = set()
+    for _ in range(samples):
+        q = rng.uniform(-1.0, 1.0, model.n)
+        try:
+            D = mass_matrix(model, q)
+        except DynamicsInputError:
+            return None
+        scale = max(float(np.abs(np.diag(D)).max()), 1e-300)
+        L = np.zeros_like(D)
+        bad = None
+        for i in range(model.n):    # Cholesky, noting the first bad pivot
+            pivot = D[i, i] - L[i, :i] @ L[i, :i]
+            if not pivot > 1e-12 * scale:
+                bad = i
+                break
+            L[i, i] = math.sqrt(pivot)
+            for k in range(i + 1, model.n):
+                L[k, i] = (D[k, i] - L[k, :i] @ L[i, :i]) / L[i, i]
+        if bad is None:
+            return None
+        joints.add(bad)
+    j = min(joints)
+    return (f'{origin}: joint {model.joint_names[j]!r}: the mass matrix D(q) '
+            f'is singular there (the links it moves carry no mass or '
+            f'inertia about its axis): inverse dynamics works, forward '
+            f'dynamics and simulation do not')
 
 
 def is_urdf(name_or_path):
@@ -325,13 +460,17 @@ def inspect_robot(name_or_path, base=None, tip=None):
     if is_urdf(name_or_path):
         from .urdf import inspect_urdf
         model, found, _ = inspect_urdf(name_or_path, base=base, tip=tip)
-        return model, found, str(name_or_path)
-    if base is not None or tip is not None:
-        raise RobotFileError(f'{name_or_path}: base and tip links apply to '
-                             f'URDF robots (.urdf files) only')
-    path = resolve_robot_path(name_or_path)
-    data = read_yaml(path)
-    model, found = robot_from_dict(data, os.path.basename(path))
+        path = str(name_or_path)
+    else:
+        if base is not None or tip is not None:
+            raise RobotFileError(f'{name_or_path}: base and tip links apply '
+                                 f'to URDF robots (.urdf files) only')
+        path = resolve_robot_path(name_or_path)
+        data = read_yaml(path)
+        model, found = robot_from_dict(data, os.path.basename(path))
+    singular = singular_joint_warning(model, os.path.basename(path))
+    if singular:
+        found.append(singular)
     return model, found, path
 
 

@@ -29,7 +29,7 @@ import numpy as np
 
 from .errors import RobotFileError
 from .model import inertia_matrix, with_payload
-from .robot_file import (_check_keys, inspect_robot, read_yaml, to_number,
+from .robot_file import (_check_keys, _short, inspect_robot, read_yaml, to_number,
                          to_vector)
 
 SCENE_KEYS = {'name', 'description', 'robot', 'effects', 'initial',
@@ -148,7 +148,7 @@ def _flag_or_block(value, where):
     if isinstance(value, (dict, list)):
         return True, value
     raise RobotFileError(f'{where}: must be true, false or a mapping, '
-                         f'got {value!r}')
+                         f'got {_short(value)!r}')
 
 
 def _per_joint(value, n, where, minimum=0.0):
@@ -168,7 +168,7 @@ def _wrench(block, where):
     frame = block.get('frame', 'base')
     if frame not in ('base', 'end_effector'):
         raise RobotFileError(f"{where}.frame: must be 'base' or "
-                             f"'end_effector', got {frame!r}")
+                             f"'end_effector', got {_short(frame)!r}")
     kinds = [k for k in ('constant', 'schedule', 'source') if k in block]
     if len(kinds) != 1:
         raise RobotFileError(f'{where}: give exactly one of constant, '
@@ -179,7 +179,7 @@ def _wrench(block, where):
     if 'source' in block:
         if block['source'] != 'topic':
             raise RobotFileError(f"{where}.source: must be 'topic', got "
-                                 f"{block['source']!r}")
+                                 f"{_short(block['source'])!r}")
         return WrenchSchedule('topic', frame, np.zeros(1), np.zeros((1, 6)))
     rows = block['schedule']
     if not isinstance(rows, list) or not rows:
@@ -223,7 +223,7 @@ def _reference(block, n, q0, where):
                  if 'phase' in block else zeros)
         return Reference('sinusoid', offset, offset, 0.0, amp, freq, phase)
     raise RobotFileError(f"{where}.type: must be 'quintic' or 'sinusoid', "
-                         f'got {kind!r}')
+                         f'got {_short(kind)!r}')
 
 
 def scene_from_dict(data, origin, base_dir='.'):
@@ -248,7 +248,7 @@ def scene_from_dict(data, origin, base_dir='.'):
         gravity = True
     elif not isinstance(gravity, bool):
         raise RobotFileError(f'{w}.gravity: must be true, false or '
-                             f'[gx, gy, gz], got {gravity!r}')
+                             f'[gx, gy, gz], got {_short(gravity)!r}')
     velocity = eff.get('velocity_products', True)
     if not isinstance(velocity, bool):
         raise RobotFileError(f'{w}.velocity_products: must be true or false')
@@ -326,7 +326,7 @@ def scene_from_dict(data, origin, base_dir='.'):
     method = integ.get('method', 'rk4')
     if method not in INTEGRATORS:
         raise RobotFileError(f'{origin}: integrator.method: must be one of '
-                             f'{", ".join(INTEGRATORS)}, got {method!r}')
+                             f'{", ".join(INTEGRATORS)}, got {_short(method)!r}')
     step = to_number(integ.get('step'), f'{origin}: integrator.step')
     duration = to_number(integ.get('duration'),
                          f'{origin}: integrator.duration')
@@ -358,6 +358,9 @@ def scene_dirs():
 def load_scene(name_or_path):
     """Load a scene file (a path, or a bundled scene's name)."""
     path = os.fspath(name_or_path)
+    if os.path.isdir(path):
+        raise RobotFileError(f'{_short(path)}: is a directory, not a scene '
+                             f'file')
     if not os.path.isfile(path):
         for folder in scene_dirs():
             candidate = os.path.join(folder, path + '.yaml')
@@ -365,8 +368,8 @@ def load_scene(name_or_path):
                 path = candidate
                 break
         else:
-            raise RobotFileError(f'{path}: no such file, and not a bundled '
-                                 f'scene')
+            raise RobotFileError(f'{_short(path)}: no such file, and not a '
+                                 f'bundled scene')
     data = read_yaml(path)
     return scene_from_dict(data, os.path.basename(path),
                            os.path.dirname(os.path.abspath(path)))

@@ -478,6 +478,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     """
+    from .robot_file import Note
     name, root, links, joints = parse_urdf(text, label)
     found = []
     base = root if base is None else base
@@ -581,11 +582,11 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
                 eig = lk.eig
                 tol = 1e-9 * max(eig[2], 1e-300)
                 if eig[0] + eig[1] < eig[2] - tol:
-                    found.append(
+                    found.append(Note(
                         f'{label}: link {lname!r} <inertia>: principal '
                         f'moments {eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} '
                         f'break the triangle inequality (no real body has '
-                        f'them); accepted as published')
+                        f'them); accepted as published'))
     limits = []
     for jname in moving:
         lim = {}
