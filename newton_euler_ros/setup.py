@@ -71,10 +71,10 @@ setup(
         'console_scripts': [
             'newton-euler = newton_euler_ros.cli:main',
             'inverse_dynamics_node = '
-            'newton_euler_ros.nodes.inverse_dynamics_node:main',
-            'robot_sim_node = newton_euler_ros.nodes.robot_sim_node:main',
+            'newton_euler_ros.nodes.entry:inverse_dynamics_node',
+            'robot_sim_node = newton_euler_ros.nodes.entry:robot_sim_node',
             'tracking_controller_node = '
-            'newton_euler_ros.nodes.tracking_controller_node:main',
+            'newton_euler_ros.nodes.entry:tracking_controller_node',
         ],
     },
 )

@@ -310,6 +310,13 @@ def test_stops_cleanly(graph):
     (['-p', 'tip_link:=tool0'],
      'robot_file: puma560: base and tip links apply to URDF robots'),
     (['-p', 'robot_file:='], 'cannot start'),
+    (['-p', 'wrench.timeout:=1'], 'wrench.timeout: wrong type: Trying to set '
+                                  "parameter 'wrench.timeout' to '1' of type"
+                                  " 'INTEGER', expecting type 'DOUBLE'"),
+    (['-p', 'payload.com:=[0, 0, 1]'], 'payload.com: wrong type'),
+    (['-p', 'payload.mass:=-2.0'], 'payload.mass: must be >= 0'),
+    (['-p', 'mode:=gravity', '-p', 'acceleration_source:=reference'],
+     'acceleration_source: reference needs mode full'),
 ])
 def test_bad_parameters_refuse_to_start(tmp_path, args, message):
     proc = subprocess.run(node_cmd(*args), env=ros_env(domain_id(29)),
@@ -317,6 +324,9 @@ def test_bad_parameters_refuse_to_start(tmp_path, args, message):
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr
     assert 'Traceback' not in proc.stderr
+    # one line, after the log lines of start-up
+    assert len([line for line in proc.stderr.splitlines()
+                if not line.startswith('[')]) == 1, proc.stderr
 
 
 def test_reference_accelerations_enter_the_torques(tmp_path, model):
@@ -397,3 +407,28 @@ def test_latency_benchmark_runs(tmp_path):
     assert 'child exit codes after SIGINT: inverse_dynamics_node 0' in \
         proc.stdout
     assert json.loads(out.read_text())
+
+
+@pytest.mark.parametrize('sig', ['SIGINT', 'SIGTERM'])
+def test_a_stop_during_start_up_is_one_line(sig):
+    """SIGINT or SIGTERM while the node imports, loads, warms up: exit 0."""
+    import signal
+    import time
+    env = ros_env(domain_id(31))
+    for delay in (0.2, 1.0, 1.8, 2.6):
+        proc = subprocess.Popen(node_cmd(), env=env, stdout=subprocess.PIPE,
+                                stderr=subprocess.PIPE, text=True)
+        time.sleep(delay)
+        proc.send_signal(getattr(signal, sig))
+        try:
+            out, err = proc.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            proc.kill()         # leave nothing running in the domain
+            out, err = proc.communicate()
+            raise AssertionError(f'still running {delay} s after {sig}: '
+                                 f'{err}') from None
+        assert proc.returncode == 0, (delay, err)
+        assert 'Traceback' not in err and 'Error' not in err, (delay, err)
+        lines = [line for line in err.splitlines()
+                 if not line.startswith('[')]
+        assert len(lines) <= 1, (delay, err)

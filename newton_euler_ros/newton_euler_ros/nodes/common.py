@@ -17,7 +17,8 @@ What every node of the package shares: QoS from parameters, and main().
 
 ``run_node`` is the Jazzy-style main: init, build the node (a
 configuration error refuses to start with a one-line reason and exit
-status 2), spin until SIGINT/SIGTERM or shutdown, destroy, shut down.
+status 2), spin until SIGINT/SIGTERM or shutdown, destroy, shut down;
+a stop is exit status 0, also during start-up (one line).
 
 Spinning uses rclpy's EventsExecutor through ``spin_once`` when it is
 available: measured with ``make latency``, it halves the node's CPU use
@@ -31,9 +32,11 @@ import sys
 
 from rcl_interfaces.msg import ParameterDescriptor
 import rclpy
+from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, \
     SingleThreadedExecutor
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.signals import SignalHandlerOptions
 
 
 class ConfigurationError(Exception):
@@ -47,10 +50,31 @@ def qos_profile(depth, reliability):
         else ReliabilityPolicy.BEST_EFFORT))
 
 
+def declare_parameter(node, name, default, descriptor):
+    """
+    Declare a parameter; a value of the wrong type is a ConfigurationError.
+
+    rclpy raises InvalidParameterTypeException with a traceback when, say,
+    ``-p wrench.timeout:=1`` gives an integer for a double: turn it into
+    one line that says what to write.
+    """
+    try:
+        return node.declare_parameter(name, default, descriptor)
+    except ParameterException as exc:
+        hint = ''
+        if isinstance(default, float) or (
+                isinstance(default, list) and default
+                and isinstance(default[0], float)):
+            hint = ' (write doubles with a decimal point, e.g. 1.0)'
+        raise ConfigurationError(
+            f'{name}: wrong type: {str(exc).splitlines()[0][:300]}'
+            f'{hint}') from None
+
+
 def declare(node, name, default, description):
     """Declare a parameter with a description; return its value."""
-    return node.declare_parameter(
-        name, default, ParameterDescriptor(description=description)).value
+    return declare_parameter(node, name, default, ParameterDescriptor(
+        description=description)).value
 
 
 def make_executor():
@@ -66,15 +90,16 @@ def make_executor():
 
 def run_node(make_node, name, args=None):
     """Run a node until shutdown; return the process exit status."""
-    # rclpy's SIGINT handler shuts the context down and then chains to the
-    # previous handler; Python's default one would raise KeyboardInterrupt
-    # wherever the main thread is, which inside an executor callback
-    # surfaces as a RuntimeError and exit status 1.  A no-op handler leaves
-    # the clean stop to rclpy (installed before init, so rclpy chains to
-    # it).
-    signal.signal(signal.SIGINT, lambda signum, frame: None)
+    # SIGINT and SIGTERM only ask for a stop: the spin loop ends within
+    # one spin period, and a stop asked for during start-up (while the
+    # node loads its model and warms its kernels) waits for the
+    # constructor.  rclpy's own handlers would shut the context down under
+    # the constructor or a publishing callback (RCLError tracebacks).
+    stop = []
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda signum, frame: stop.append(signum))
     try:
-        rclpy.init(args=args)
+        rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:  # e.g. malformed --ros-args: say so, briefly
         print(f'{name}: cannot start: {exc}'.splitlines()[0],
               file=sys.stderr)
@@ -82,18 +107,16 @@ def run_node(make_node, name, args=None):
     node = None
     code = 0
     try:
-        node = make_node()
+        if not stop:
+            node = make_node()
+        if stop:
+            print(f'{name}: stopped during start-up '
+                  f'({signal.Signals(stop[0]).name})', file=sys.stderr)
+            return 0
         executor = make_executor()
         executor.add_node(node)
-        while rclpy.ok():
-            try:
-                executor.spin_once(timeout_sec=0.1)
-            except Exception:
-                if rclpy.ok():
-                    raise
-                # SIGINT shut the context down while a callback was still
-                # publishing: that is the stop we were asked for
-                break
+        while rclpy.ok() and not stop:
+            executor.spin_once(timeout_sec=0.1)
     except ConfigurationError as exc:
         print(f'{name}: invalid parameters: {exc}', file=sys.stderr)
         code = 2

@@ -50,7 +50,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
-from .common import ConfigurationError, qos_profile, run_node
+from .common import (ConfigurationError, declare_parameter, qos_profile,
+                     run_node)
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
 from ..core.trajectory import trajectory_efforts
@@ -255,14 +256,14 @@ class InverseDynamicsNode(Node):
                                        read_only=spec.read_only)
             if spec.default == [] or spec.default == '':
                 # an empty default does not tell rclpy the type
-                self.declare_parameter(spec.name, _PARAM_TYPES[spec.type],
-                                       desc)
+                declare_parameter(self, spec.name,
+                                  _PARAM_TYPES[spec.type], desc)
                 param = self.get_parameter_or(spec.name, None)
                 value = param.value if param is not None else None
                 values[spec.name] = spec.default if value is None else value
             else:
-                values[spec.name] = self.declare_parameter(
-                    spec.name, spec.default, desc).value
+                values[spec.name] = declare_parameter(
+                    self, spec.name, spec.default, desc).value
             values[spec.name] = _plain(values[spec.name])
         errors = validate(values, self.specs)
         if errors:
