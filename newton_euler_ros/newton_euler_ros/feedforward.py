@@ -42,6 +42,12 @@ EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
 
 
+def clip(text, limit=300):
+    """Return text cut to ``limit`` characters (for logs and messages)."""
+    text = str(text)
+    return text if len(text) <= limit else text[:limit] + '...'
+
+
 class InputRejected(Exception):
     """An input message cannot be used; ``kind`` names the counter."""
 
@@ -62,8 +68,10 @@ class JointOrder:
 
     """
 
-    def __init__(self, model_joints, output_joints=None):
+    def __init__(self, model_joints, output_joints=None, max_names=0):
         self.model_joints = tuple(model_joints)
+        #: longer name lists are rejected before any per-name work
+        self.max_names = max_names or 4 * len(self.model_joints) + 16
         output = tuple(output_joints) if output_joints else self.model_joints
         if len(set(output)) != len(output):
             dup = next(j for j in output if output.count(j) > 1)
@@ -92,14 +100,23 @@ class JointOrder:
             return self._cache_take
         where = {}
         for i, name in enumerate(names):
+            if not name.isprintable():
+                raise InputRejected('malformed',
+                                    f'joint name {clip(name, 60)!r} has '
+                                    f'control characters')
             if name in where:
                 raise InputRejected('malformed',
-                                    f'joint {name!r} appears twice')
+                                    f'joint {clip(name, 60)!r} appears '
+                                    f'twice')
             where[name] = i
         missing = [j for j in self.model_joints if j not in where]
         if missing:
-            raise InputRejected('missing_joints',
-                                f'missing joints {missing}')
+            known = set(self.model_joints)
+            unknown = [clip(x, 60) for x in names if x not in known][:5]
+            raise InputRejected(
+                'missing_joints', f'missing joints {missing}'
+                + (f'; not joints of the robot: {unknown}' if unknown
+                   else ''))
         take = np.array([where[j] for j in self.model_joints], dtype=np.intp)
         self._cache_names = list(names)
         self._cache_take = take
@@ -111,6 +128,10 @@ class JointOrder:
 
         An empty ``values`` gives None when not ``required``.
         """
+        if len(names) > self.max_names or len(values) > self.max_names:
+            raise InputRejected(
+                'oversized', f'{max(len(names), len(values))} names or '
+                f'values, more than the {self.max_names} accepted')
         names = list(names)
         if len(values) == 0 and not required:
             return None
@@ -158,7 +179,8 @@ class WrenchInput:
     """
 
     def __init__(self, base_frames, end_effector_frames,
-                 convention=EXERTED_BY_ROBOT, timeout=0.5, rigid_frames=None):
+                 convention=EXERTED_BY_ROBOT, timeout=0.5, rigid_frames=None,
+                 bounds=(np.inf, np.inf)):
         both = set(base_frames) & set(end_effector_frames)
         if both:
             raise ValueError(f'frame {sorted(both)[0]!r} is listed as both a '
@@ -179,6 +201,7 @@ class WrenchInput:
                 continue
             self.transforms[frame_id] = (T[:3, :3].copy(), T[:3, 3].copy())
         self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
+        self.max_force, self.max_moment = bounds
         self.timeout = timeout
         self.wrench = None
         self.frame = 'base'
@@ -190,12 +213,20 @@ class WrenchInput:
         frame = self.frames.get(frame_id)
         if frame is None:
             raise InputRejected(
-                'unknown_frame', f'wrench frame_id {frame_id!r} is not one '
-                f'of {sorted(self.frames)}')
+                'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} '
+                f'is not one of {clip(sorted(self.frames), 200)}')
         w = np.asarray(values, dtype=np.float64)
         if not np.isfinite(w).all():
             raise InputRejected('non_finite', f'wrench has a non-finite '
                                 f'entry: {w.tolist()}')
+        # component-wise (a norm of 1e200 would overflow)
+        force, moment = np.abs(w[:3]).max(), np.abs(w[3:]).max()
+        if force > self.max_force or moment > self.max_moment:
+            raise InputRejected(
+                'implausible', f'wrench with a force of {force:.4g} N or a '
+                f'moment of {moment:.4g} N m along an axis is beyond the '
+                f'plausible {self.max_force:.4g} N, {self.max_moment:.4g} '
+                f'N m')
         if stamp == 0.0:          # unstamped: take it as of now
             stamp = now
         if self.timeout and now - stamp > self.timeout:
@@ -398,12 +429,42 @@ class FeedforwardComputer:
         gravity_torques(self.model, z, ws=self.ws)
         self._torques(z, z, z, None, 'base')
 
+    #: speeds above these are implausible (model order); set by the node
+    velocity_bounds = None
+    #: joint-state stamp policy (seconds): ahead of now, and age (0: off)
+    max_future = 1.0
+    max_age = 0.0
+
+    def check_stamp(self, stamp, now):
+        """Reject negative, far-future and (optionally) stale stamps."""
+        if stamp == 0.0:
+            return now          # unknown: taken as now
+        if stamp < 0.0:
+            raise InputRejected('bad_stamp', f'stamp {stamp:.3f} s is '
+                                f'negative')
+        if stamp - now > self.max_future:
+            raise InputRejected('bad_stamp', f'stamped {stamp - now:.3f} s '
+                                f'in the future (max {self.max_future} s)')
+        if self.max_age and now - stamp > self.max_age:
+            raise InputRejected('stale', f'{now - stamp:.3f} s old (max '
+                                f'{self.max_age} s)')
+        return stamp
+
     def torques(self, names, position, velocity, stamp, now):
         """Output-ordered torques for one joint state, or InputRejected."""
+        stamp = self.check_stamp(stamp, now)
         q = self.order.gather(names, 'position', position)
         qd = self.order.gather(names, 'velocity', velocity, required=False)
         if qd is None:
             qd = np.zeros(self.model.n)
+        elif self.velocity_bounds is not None:
+            over = np.abs(qd) > self.velocity_bounds
+            if over.any():
+                k = int(np.argmax(over))
+                raise InputRejected(
+                    'implausible', f'velocity of '
+                    f'{self.model.joint_names[k]!r} is {qd[k]:.4g}, beyond '
+                    f'the plausible {self.velocity_bounds[k]:.4g}')
         qdd = (self.reference.acceleration(stamp)
                if self.mode == 'full' and self.reference is not None
                else None)

@@ -42,6 +42,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
+import numpy as np
 from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -56,10 +57,12 @@ from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
 from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
-from ..feedforward import (check_payload, FeedforwardComputer,
+from ..feedforward import (check_payload, clip, FeedforwardComputer,
                            InputRejected, JointOrder, payload_model,
                            ReferenceTrajectory, rigid_frames, WrenchInput)
 from ..parameters import load_specs, validate
+from ..safety import (effort_bounds, TorqueGuard, velocity_bounds,
+                      wrench_bounds)
 
 _PARAM_TYPES = {
     'string': Parameter.Type.STRING, 'double': Parameter.Type.DOUBLE,
@@ -71,7 +74,8 @@ COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
             'service_calls', 'service_failures', 'internal_error',
             'no_model', 'descriptions_loaded', 'descriptions_rejected',
-            'trajectories', 'payload_changes')
+            'trajectories', 'payload_changes', 'implausible', 'over_limit',
+            'oversized', 'bad_stamp')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -187,12 +191,33 @@ class InverseDynamicsNode(Node):
             order, wrench = previous.order, previous.wrench
             reference = previous.reference
         else:
-            order = JointOrder(model.joint_names, p['joints'] or None)
-            wrench = self._wrench_input(p, model)
+            order = JointOrder(model.joint_names, p['joints'] or None,
+                               p['limits.max_names'])
+            wrench = None
             reference = (ReferenceTrajectory(order)
                          if self.mode == 'full' else None)
+        # torque bounds: the parameter (output order), the robot's, or
+        # derived from the model (with its payload)
+        override = p['limits.effort']
+        if len(override) and len(override) != model.n:
+            raise ValueError(f'limits.effort: must have {model.n} values '
+                             f'(one per joint), got {len(override)}')
+        if len(override):
+            model_order = np.empty(model.n)
+            model_order[order.to_output] = override
+            override = model_order
+        bounds, sources = effort_bounds(model, override)
+        if wrench is None:
+            wrench = self._wrench_input(p, model, bounds)
         ff = FeedforwardComputer(model, order, wrench, reference, scene,
                                  self.mode)
+        ff.guard = TorqueGuard(order.to_output_order(bounds),
+                               p['limits.action'])
+        ff.bound_sources = [sources[k] for k in order.to_output]
+        ff.velocity_bounds = velocity_bounds(model, p['limits.velocity_factor'],
+                                             p['limits.max_velocity'])
+        ff.max_future = p['joint_states.max_future']
+        ff.max_age = p['joint_states.max_age']
         ff.warm_up()   # compile or load the kernels before any message
         ff.output_names = list(order.output_joints)
         ff.bare_model = bare
@@ -270,11 +295,11 @@ class InverseDynamicsNode(Node):
             raise ConfigurationError('; '.join(errors))
         return values
 
-    def _wrench_input(self, p, model):
+    def _wrench_input(self, p, model, bounds):
         return WrenchInput(p['wrench.base_frames'],
                            p['wrench.end_effector_frames'],
                            p['wrench.convention'], p['wrench.timeout'],
-                           rigid_frames(model))
+                           rigid_frames(model), wrench_bounds(bounds))
 
     def _on_set_parameters(self, params):
         values = {param.name: _plain(param.value) for param in params}
@@ -292,7 +317,8 @@ class InverseDynamicsNode(Node):
         new_ff = None
         if ff is not None:
             try:
-                new_wrench = self._wrench_input(current, ff.model)
+                new_wrench = self._wrench_input(current, ff.model,
+                                                ff.guard.bounds)
                 if payload != self.payload:
                     # a new model and workspace, built here, off the hot
                     # path; everything else carries over
@@ -336,8 +362,8 @@ class InverseDynamicsNode(Node):
         if now - last >= self.log_throttle:
             self._last_log[kind] = now
             self.get_logger().warning(
-                f'dropped {source}: {exc} ({kind}: {self.counts[kind]} so '
-                f'far)')
+                f'dropped {source}: {clip(exc)} ({kind}: '
+                f'{self.counts[kind]} so far)')
 
     def _no_model(self, _source):
         # said once at start-up and in /diagnostics; counted, not logged
@@ -363,6 +389,11 @@ class InverseDynamicsNode(Node):
         except Exception as exc:  # never let a message kill the node
             self._reject('joint state', exc)
             return
+        tau, exceeded = ff.guard.check(tau)
+        if exceeded:
+            self._over_limit(ff, 'torque command')
+            if tau is None:
+                return
         values = tau.tolist()
         self._cmd.data = values
         self.cmd_pub.publish(self._cmd)
@@ -371,6 +402,20 @@ class InverseDynamicsNode(Node):
         self._torques.effort = values
         self.torque_pub.publish(self._torques)
         self.counts['published'] += 1
+
+    def _over_limit(self, ff, what):
+        self.counts['over_limit'] += 1
+        action = {'clamp': 'clamped to it', 'drop': 'not published',
+                  'publish': 'published anyway'}[ff.guard.action]
+        now = time.monotonic()
+        if now - self._last_log.get('over_limit', -1e300) >= \
+                self.log_throttle:
+            self._last_log['over_limit'] = now
+            self.get_logger().warning(
+                f'{what} above the torque bound ({action}): bounds '
+                f'{ff.guard.bounds.tolist()} N m/N from '
+                f'{sorted(set(ff.bound_sources))} '
+                f'({self.counts["over_limit"]} so far)')
 
     def _on_wrench(self, msg):
         w = msg.wrench
@@ -426,7 +471,18 @@ class InverseDynamicsNode(Node):
         except Exception as exc:
             self._reject('trajectory', exc)
             return
-        for pt, effort in zip(msg.points, efforts):
+        out = efforts.copy()
+        exceeded = False
+        for k in range(out.shape[0]):
+            row, over = ff.guard.check(efforts[k])
+            exceeded |= over
+            if row is None:
+                self._over_limit(ff, 'trajectory effort')
+                return
+            out[k] = row
+        if exceeded:
+            self._over_limit(ff, 'trajectory effort')
+        for pt, effort in zip(msg.points, out):
             pt.effort = effort.tolist()
         self.traj_pub.publish(msg)
         self.counts['trajectories'] += 1
@@ -485,7 +541,12 @@ class InverseDynamicsNode(Node):
             KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
             KeyValue(key='payload.inertia',
                      value=repr(list(self.payload[2]))),
-            KeyValue(key='source', value=_clip(self.model_source))]
+            KeyValue(key='source', value=_clip(self.model_source)),
+            KeyValue(key='limits.action', value=self.params['limits.action']),
+            KeyValue(key='torque_bounds', value=repr(
+                ff.guard.bounds.tolist() if ff is not None else [])),
+            KeyValue(key='torque_bound_sources', value=repr(
+                ff.bound_sources if ff is not None else []))]
         msg = DiagnosticArray(status=[status, model])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)

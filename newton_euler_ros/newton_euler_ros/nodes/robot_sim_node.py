@@ -70,6 +70,7 @@ from ..core.scene import load_scene
 from ..core.simulate import integrator_step, SceneDynamics
 from ..core.trajectory import TrajectoryFollower
 from ..feedforward import payload_model
+from ..safety import effort_bounds, TorqueGuard
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -136,6 +137,17 @@ class RobotSimNode(Node):
             raise ConfigurationError(str(exc)) from None
         self.follower = TrajectoryFollower(scene.model)
         self.commands = 0            # commands received on ~/commands
+        self.over_limit = 0          # commands beyond the torque bounds
+        # the same torque guard as inverse_dynamics_node: the robot's
+        # effort limits, else bounds derived from it
+        try:
+            self.guard = TorqueGuard(
+                effort_bounds(scene.model)[0],
+                declare(self, 'limits.action', 'clamp', 'What a commanded '
+                        'torque above its bound does: clamp, drop (keep the '
+                        'previous command) or publish (apply it anyway).'))
+        except ValueError as exc:
+            raise ConfigurationError(str(exc)) from None
         n = scene.model.n
         self.q = scene.q0.astype(float).copy()
         self.qd = scene.qd0.astype(float).copy()
@@ -202,9 +214,12 @@ class RobotSimNode(Node):
                     f'torques, got {data.size} values ({self.dropped} '
                     f'dropped so far); holding the previous command')
             return
+        self.commands += 1
+        data = self._guarded(data)
+        if data is None:
+            return
         self.tau = data
         self.commanded = True
-        self.commands += 1
 
     def _ready(self):
         if not self.wait:
@@ -276,6 +291,17 @@ class RobotSimNode(Node):
         msg.effort = self.applied.tolist()
         self.state_pub.publish(msg)
 
+    def _guarded(self, tau):
+        """Apply the torque guard to a command (None: keep the last one)."""
+        out, exceeded = self.guard.check(tau)
+        if exceeded:
+            self.over_limit += 1
+            self.get_logger().warning(
+                f'command above the torque bounds {self.guard.bounds.tolist()}'
+                f' ({self.guard.action}; {self.over_limit} so far)',
+                throttle_duration_sec=2.0)
+        return out
+
     def _plant(self, payload):
         """Scene dynamics with a payload on the end effector."""
         model = payload_model(self.scene.model, *payload)
@@ -325,7 +351,9 @@ class RobotSimNode(Node):
             return self.tau
         q_d, qd_d, eff = desired
         sc = self.scene
-        return sc.kp * (q_d - self.q) + sc.kd * (qd_d - self.qd) + eff
+        tau = self._guarded(sc.kp * (q_d - self.q) + sc.kd * (qd_d - self.qd)
+                            + eff)
+        return self.tau if tau is None else tau
 
     def _on_wrench(self, msg):
         """

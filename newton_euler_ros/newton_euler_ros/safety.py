@@ -1,0 +1,138 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+What a node may publish and accept: torque, velocity and wrench bounds.
+
+ROS-free, shared by inverse_dynamics_node and robot_sim_node.
+
+Torque bounds, per joint, in this order of precedence: the ``effort``
+parameter list, the robot's own limits (robot file ``limits.effort`` or
+URDF ``<limit effort>``), else a bound derived from the robot, for robots
+that state none: twice the largest torque the arm needs to hold itself,
+accelerate every joint at a brisk 20 rad/s^2 (or m/s^2) at once, and push
+on its environment with its own weight W = m_total |g| (a force of W
+along each axis and a moment of W times 10 cm about each), over 64
+random configurations,
+
+    bound_j = 2 max_q (|g_j| + 20 sum_k |D_jk| + sum_i |J_ij| w_i).
+
+That is no actuator's rating, but no feedforward for a sane motion or
+contact exceeds it, and it stops absurd values (1e200 N m) from reaching
+an effort controller.  What happens above a bound is a choice
+(:data:`ACTIONS`): ``clamp`` to the bound (the default, as ros2_control's
+joint limiters do: a dropped feedforward would leave the controller on a
+stale command), ``drop`` the message, or ``publish`` it anyway; every case
+is counted.
+
+Implausible inputs are rejected before the dynamics, like a NaN: a joint
+speed above ``velocity_factor`` times the robot's velocity limit (or above
+``max_velocity`` for joints without one), and a wrench whose force or
+moment is beyond what ten times the largest torque bound could resist
+through a 10 cm lever (force) or directly (moment).
+"""
+import numpy as np
+
+from .core import gravity_torques, jacobian, mass_matrix
+
+ACTIONS = ('clamp', 'drop', 'publish')
+ACCELERATION = 20.0         # rad/s^2 (or m/s^2) for the derived bound
+SAMPLES = 64
+
+
+def derived_effort_bounds(model, seed=0):
+    """Per-joint bounds for a robot without effort limits (see above)."""
+    rng = np.random.default_rng(seed)
+    lo = np.array([lim.get('lower', -np.pi) for lim in model.limits])
+    hi = np.array([lim.get('upper', np.pi) for lim in model.limits])
+    weight = model.total_mass * float(np.linalg.norm(model.gravity))
+    push = np.array([weight] * 3 + [0.1 * weight] * 3)
+    need = np.zeros(model.n)
+    for _ in range(SAMPLES):
+        q = rng.uniform(lo, hi)
+        g = np.abs(gravity_torques(model, q))
+        D = np.abs(mass_matrix(model, q))
+        J = np.abs(jacobian(model, q))
+        need = np.maximum(need, g + ACCELERATION * D.sum(axis=1)
+                          + J.T @ push)
+    return 2.0 * need
+
+
+def effort_bounds(model, override=()):
+    """
+    Return (bounds, sources) in the model's joint order.
+
+    ``override``: n positive values, or empty.  ``sources[j]`` says where
+    bound j comes from: ``'parameter'``, ``'robot'`` or ``'derived'``.
+    """
+    n = model.n
+    if len(override):
+        values = np.asarray(override, dtype=np.float64)
+        if values.shape != (n,) or not (np.isfinite(values).all()
+                                        and (values > 0).all()):
+            raise ValueError(f'limits.effort: must be {n} finite values > 0 '
+                             f'(one per joint, output order), got '
+                             f'{list(override)[:n + 1]}')
+        return values, ['parameter'] * n
+    bounds = np.array([lim.get('effort', np.nan) for lim in model.limits],
+                      dtype=np.float64).reshape(n)
+    sources = ['robot' if np.isfinite(b) else 'derived' for b in bounds]
+    if 'derived' in sources:
+        derived = derived_effort_bounds(model)
+        bounds = np.where(np.isfinite(bounds), bounds, derived)
+    return bounds, sources
+
+
+def velocity_bounds(model, factor=2.0, fallback=20.0):
+    """Speeds above these are implausible (model order)."""
+    vel = np.array([lim.get('velocity', np.nan) for lim in model.limits],
+                   dtype=np.float64).reshape(model.n)
+    return np.where(np.isfinite(vel), factor * vel, fallback)
+
+
+def wrench_bounds(bounds):
+    """(force N, moment N m) beyond which a wrench is implausible."""
+    top = float(np.max(bounds))
+    return 10.0 * top / 0.1, 10.0 * top
+
+
+class TorqueGuard:
+    """
+    Apply the torque bounds to outgoing torques (output order).
+
+    :meth:`check` returns the torques to publish (clamped if so chosen)
+    or None to drop the message, and whether a bound was exceeded.
+    """
+
+    def __init__(self, bounds, action='clamp'):
+        if action not in ACTIONS:
+            raise ValueError(f'limits.action: must be one of '
+                             f'{", ".join(ACTIONS)}, got {action!r}')
+        self.bounds = np.asarray(bounds, dtype=np.float64)
+        self.action = action
+
+    def check(self, tau):
+        """Return (torques or None, exceeded)."""
+        over = np.abs(tau) > self.bounds
+        if not over.any():
+            return tau, False
+        if self.action == 'drop':
+            return None, True
+        if self.action == 'clamp':
+            return np.clip(tau, -self.bounds, self.bounds), True
+        return tau, True
+
+    def worst(self, tau):
+        """Index of the joint furthest beyond its bound (for a message)."""
+        return int(np.argmax(np.abs(tau) / self.bounds))
