@@ -17,8 +17,9 @@ Launch inverse_dynamics_node with a bundled parameter file (apt ROS).
 
     ros2 launch newton_euler_ros inverse_dynamics.launch.py robot:=puma560
 
-Remap ``joint_states`` and ``wrench`` as your graph needs, e.g.
-``ros2 launch ... joint_states:=/my_robot/joint_states``.
+Remap ``joint_states``, ``wrench`` and the command as your graph needs,
+e.g. ``ros2 launch ... joint_states:=/my_robot/joint_states
+torque_command:=/effort_controller/commands``.
 """
 import os
 
@@ -43,6 +44,11 @@ def generate_launch_description():
                               description='parameter file (overrides robot)'),
         DeclareLaunchArgument('joint_states', default_value='joint_states'),
         DeclareLaunchArgument('wrench', default_value='wrench'),
+        DeclareLaunchArgument(
+            'torque_command',
+            default_value='inverse_dynamics_node/torque_command',
+            description='topic of the Float64MultiArray command, e.g. '
+                        '/effort_controller/commands'),
         Node(
             package='newton_euler_ros',
             executable='inverse_dynamics_node',
@@ -52,6 +58,7 @@ def generate_launch_description():
             remappings=[
                 ('joint_states', LaunchConfiguration('joint_states')),
                 ('wrench', LaunchConfiguration('wrench')),
+                ('~/torque_command', LaunchConfiguration('torque_command')),
             ],
         ),
     ])

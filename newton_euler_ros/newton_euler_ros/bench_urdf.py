@@ -25,11 +25,11 @@ Both kinds compile to the same kernel arrays, so the per-call cost should
 not depend on the source: the ratio column shows it.
 """
 import argparse
-import time
 import warnings
 
 import numpy as np
 
+from .bench_effects import _min_time
 from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
                    load_robot, mass_matrix)
 from .core.urdf import load_urdf, model_to_urdf
@@ -37,18 +37,6 @@ from .core.urdf import load_urdf, model_to_urdf
 PUBLISHED = (('ur5 (URDF)', 'ur_description/urdf/ur5_robot.urdf', 'tool0'),
              ('panda (URDF)', 'panda_description/urdf/panda.urdf',
               'panda_hand_tcp'))
-
-
-def _min_time(fn, number, repeat):
-    """Return the best time per call of ``fn`` in microseconds."""
-    fn()
-    best = float('inf')
-    for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - start) / number)
-    return best * 1e6
 
 
 def robots():

@@ -28,8 +28,6 @@ tracking, torques split by term, tracking error) and ``summary.md`` are
 written to DIR (default out/demo).
 """
 import argparse
-import contextlib
-import io
 import os
 import sys
 import time
@@ -258,13 +256,6 @@ def torque_terms(scene, run):
             if k == 'D qdd' or np.abs(v).max() > 0.0}
 
 
-def effect_costs(name, quick):
-    """Return bench_effects rows (label, us feedforward, us forward dyn.)."""
-    from .bench_effects import bench_scene
-    with contextlib.redirect_stdout(io.StringIO()):
-        return bench_scene(name, 200 if quick else 2000, 3 if quick else 5)
-
-
 def plots(scene, runs, terms, out):
     """Write the PNG plots; return their file names."""
     import matplotlib
@@ -302,14 +293,15 @@ def plots(scene, runs, terms, out):
         for label, values in terms.items():
             ax.plot(ff['t'], values[:, j], lw=1.0, label=label)
         ax.plot(ff['t'], ff['tau'][:, j], 'k', lw=0.8, alpha=0.6,
-                label='applied')
+                label='commanded (PD + feedforward)')
         ax.set_title(joints[j])
         ax.set_xlabel('t [s]')
         ax.set_ylabel('torque [N m]')
         ax.grid(alpha=0.3)
     axes[0][0].legend(fontsize=7)
-    fig.suptitle(f'{scene.name}: torques by term (recorded states, '
-                 f'with feedforward)')
+    fig.suptitle(f'{scene.name}: the terms of tau at the recorded states; '
+                 f"black: the torque the plant applied (the controller's "
+                 f'command, PD + feedforward)')
     fig.tight_layout()
     files.append('torque_terms.png')
     fig.savefig(os.path.join(out, files[-1]), dpi=100)
@@ -345,7 +337,7 @@ def plots(scene, runs, terms, out):
     return files
 
 
-def summary(scene, runs, rms, costs, files, duration, wall):
+def summary(scene, runs, rms, files, duration, wall):
     """Return summary.md's text."""
     ratio = rms['pd'] / rms['feedforward'] if rms['feedforward'] > 0 \
         else float('inf')
@@ -384,14 +376,11 @@ def summary(scene, runs, rms, costs, files, duration, wall):
         '',
         '## Compute cost per effect',
         '',
-        'Microseconds per call (best of several), from '
-        '`newton_euler_ros.bench_effects`:',
-        '',
-        '| effects | feedforward tau [us] | forward dynamics [us] |',
-        '|---|---|---|',
+        'Not timed here: a demo shares the CPU with five processes, and '
+        'timings taken beside them contradict each other. `make bench` '
+        '(`python -m newton_euler_ros.bench_effects`) times each effect '
+        'side by side on a quiet machine.',
     ]
-    lines += [f'| {label} | {t_ff:.2f} | {t_fd:.2f} |'
-              for label, t_ff, t_fd in costs]
     lines += ['', '## Plots', ''] + [f'![{f}]({f})' for f in files] + ['']
     return '\n'.join(lines)
 
@@ -451,9 +440,8 @@ def main(argv=None):
         return 1
     wall = time.monotonic() - started
     terms = torque_terms(scene, runs['feedforward'])
-    costs = effect_costs(args.scene, args.quick)
     files = plots(scene, runs, terms, out)
-    text = summary(scene, runs, rms, costs, files, duration, wall)
+    text = summary(scene, runs, rms, files, duration, wall)
     with open(os.path.join(out, 'summary.md'), 'w') as fh:
         fh.write(text)
     np.savez(os.path.join(out, 'runs.npz'),

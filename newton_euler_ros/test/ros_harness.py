@@ -20,6 +20,7 @@ localhost.  The node under test runs as its own process through its
 console script; the test talks to it from a separate rclpy context.
 """
 import os
+import sys
 import time
 
 from newton_euler_ros.processes import ChildProcess, ros_env  # noqa: F401
@@ -35,6 +36,22 @@ def domain_id(offset):
 
 # the node under test runs as a child process; stop() sends SIGINT
 NodeProcess = ChildProcess
+
+
+def id_node_cmd(params='puma560.yaml', *extra):
+    """
+    Command line of inverse_dynamics_node, as a user starts it.
+
+    Its console script (the entry point users run), else ``python -m``;
+    ``params`` is a bundled parameter file name, or None for none.
+    """
+    script = os.path.join(os.path.dirname(sys.executable),
+                          'inverse_dynamics_node')
+    base = [script] if os.path.exists(script) else [
+        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
+    files = (['--params-file', os.path.join(PARAMS_DIR, params)]
+             if params else [])
+    return base + ['--ros-args', *files, *extra]
 
 
 class Probe:

@@ -226,3 +226,20 @@ def test_check_warns_when_the_mass_matrix_is_singular(tmp_path):
             'singular there') in out
     code, out, err = run('check', 'planar_2r')
     assert 'singular' not in out
+
+
+def test_numba_cache_is_not_written_into_the_source_tree(tmp_path):
+    """Outside make, compiled kernels go to the user's cache directory."""
+    env = {k: v for k, v in os.environ.items() if k != 'NUMBA_CACHE_DIR'}
+    env['XDG_CACHE_HOME'] = str(tmp_path)
+    code = ('import os, newton_euler_ros.core as c; '
+            'c.gravity_torques(c.load_robot("planar_2r"), [0.0, 0.0]); '
+            'print(os.environ["NUMBA_CACHE_DIR"])')
+    proc = subprocess.run([sys.executable, '-W', 'ignore', '-c', code],
+                          capture_output=True, text=True, timeout=300,
+                          env=env)
+    assert proc.returncode == 0, proc.stderr
+    cache = proc.stdout.strip()
+    assert cache == str(tmp_path / 'newton_euler_ros' / 'numba')
+    assert any(name.endswith('.nbi') for _, _, files in os.walk(cache)
+               for name in files)

@@ -22,7 +22,6 @@ oversized and control-character joint states are rejected at once; bad
 stamps are rejected; logs stay short.
 """
 import os
-import sys
 import time
 import warnings
 
@@ -36,7 +35,7 @@ from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (inverse_dynamics, jacobian,  # noqa: E402
                                    load_robot)
-from ros_harness import (domain_id, NodeProcess, PARAMS_DIR,  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
                          Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
@@ -48,14 +47,8 @@ LIMITS = np.array([87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0])
 
 
 def node_cmd(*extra):
-    script = os.path.join(os.path.dirname(sys.executable),
-                          'inverse_dynamics_node')
-    base = [script] if os.path.exists(script) else [
-        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
-    return base + ['--ros-args', '--params-file',
-                   os.path.join(PARAMS_DIR, 'panda.yaml'),
-                   '-p', 'log_throttle:=0.01', '-p', 'wrench.timeout:=2.0',
-                   *extra]
+    return id_node_cmd('panda.yaml', '-p', 'log_throttle:=0.01',
+                       '-p', 'wrench.timeout:=2.0', *extra)
 
 
 @pytest.fixture(scope='module')

@@ -26,7 +26,7 @@ from newton_euler_ros.core import (coriolis_matrix, DynamicsInputError,
                                    jacobian, load_robot, make_model,
                                    mass_matrix, NotPositiveDefiniteError,
                                    wrench_torques)
-from newton_euler_ros.core import dynamics, robot_file
+from newton_euler_ros.core import dynamics
 import numpy as np
 import pytest
 
@@ -90,9 +90,14 @@ def test_massless_tail_names_the_joint():
 
 
 def test_docstring_examples_run():
-    for module in (dynamics, robot_file):
+    from newton_euler_ros.core import float32
+    ran = 0
+    for module in (dynamics, float32):     # the modules with examples
         result = doctest.testmod(module)
         assert result.failed == 0
+        assert result.attempted > 0, f'{module.__name__} ran no example'
+        ran += result.attempted
+    assert ran >= 4
 
 
 def test_condition_number_of_d(arm):

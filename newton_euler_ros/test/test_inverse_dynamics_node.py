@@ -38,8 +38,8 @@ from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (coriolis_matrix, gravity_torques,  # noqa: E402
                                    inverse_dynamics, load_robot,
                                    mass_matrix)
-from ros_harness import (domain_id, NodeProcess, PARAMS_DIR, Probe,  # noqa: E402
-                         ros_env)
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
+                         Probe, ros_env)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -52,12 +52,7 @@ TIMEOUT = 1.0   # wrench.timeout for this node, seconds
 
 
 def node_cmd(*extra):
-    script = os.path.join(os.path.dirname(sys.executable),
-                          'inverse_dynamics_node')
-    base = [script] if os.path.exists(script) else [
-        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
-    return base + ['--ros-args', '--params-file',
-                   os.path.join(PARAMS_DIR, 'puma560.yaml'), *extra]
+    return id_node_cmd('puma560.yaml', *extra)
 
 
 @pytest.fixture(scope='module')

@@ -23,7 +23,6 @@ computed independently: its weight as a wrench at the end effector
 """
 import math
 import os
-import sys
 import warnings
 
 import numpy as np
@@ -40,7 +39,7 @@ from newton_euler_ros.core import (end_effector_pose,  # noqa: E402
 from rcl_interfaces.srv import (SetParameters,  # noqa: E402
                                 SetParametersAtomically)
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import (domain_id, NodeProcess, PARAMS_DIR,  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
                          Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
@@ -52,13 +51,8 @@ NODE = '/inverse_dynamics_node'
 
 
 def node_cmd(mode, *extra):
-    script = os.path.join(os.path.dirname(sys.executable),
-                          'inverse_dynamics_node')
-    base = [script] if os.path.exists(script) else [
-        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
-    return base + ['--ros-args', '--params-file',
-                   os.path.join(PARAMS_DIR, f'puma560_{mode}.yaml'),
-                   '-p', 'log_throttle:=0.01', *extra]
+    return id_node_cmd(f'puma560_{mode}.yaml', '-p', 'log_throttle:=0.01',
+                       *extra)
 
 
 @pytest.fixture(scope='module')

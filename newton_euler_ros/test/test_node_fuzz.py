@@ -23,7 +23,6 @@ on SIGINT.
 """
 import math
 import os
-import sys
 import time
 import warnings
 
@@ -39,7 +38,7 @@ from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (DynamicsInputError,  # noqa: E402
                                    inverse_dynamics, load_robot)
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from ros_harness import (domain_id, NodeProcess, PARAMS_DIR,  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
                          Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
@@ -67,12 +66,7 @@ FRAMES_BAD = ['', 'world', 'base_link ', 'BASE_LINK', 'tool0/', '/tool0',
 
 
 def node_cmd(*extra):
-    script = os.path.join(os.path.dirname(sys.executable),
-                          'inverse_dynamics_node')
-    base = [script] if os.path.exists(script) else [
-        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
-    return base + ['--ros-args', '--params-file',
-                   os.path.join(PARAMS_DIR, 'puma560.yaml'), *extra]
+    return id_node_cmd('puma560.yaml', *extra)
 
 
 def finite(values):

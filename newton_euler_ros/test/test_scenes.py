@@ -305,3 +305,17 @@ def test_scene_controller_is_stable_sampled_at_its_rate(name):
                               controller=held_controller(
                                   SceneDynamics(sc), 1.0 / sc.rate))
         assert result.summary['tracking_max'] < 0.02, (name, gain)
+
+
+def test_a_duration_under_half_a_step_is_one_step():
+    """simulate() used to index out_tau[-2] of a one-sample result."""
+    scene = load_scene('puma_payload_press')
+    result = simulate(scene, duration=0.1 * scene.step)
+    assert result.summary['steps'] == 1 and len(result.t) == 2
+    with pytest.raises(ValueError, match='duration must be > 0'):
+        simulate(scene, duration=0.0)
+
+
+def test_friction_arrays_are_not_shared():
+    scene = load_scene('panda_orbit_slow')
+    assert scene.viscous is not scene.coulomb

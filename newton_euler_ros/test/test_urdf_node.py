@@ -24,7 +24,6 @@ wrenches as a driver and a force/torque sensor would.
 import math
 import os
 import random
-import sys
 import warnings
 
 import numpy as np
@@ -41,7 +40,7 @@ from newton_euler_ros.core.model import rpy_matrix  # noqa: E402
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
-from ros_harness import (domain_id, NodeProcess, PARAMS_DIR,  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
                          Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
@@ -58,15 +57,10 @@ SENSOR_RPY = (math.pi / 2, 0.0, math.pi / 6)
 
 
 def node_cmd(*extra):
-    script = os.path.join(os.path.dirname(sys.executable),
-                          'inverse_dynamics_node')
-    base = [script] if os.path.exists(script) else [
-        sys.executable, '-m', 'newton_euler_ros.nodes.inverse_dynamics_node']
     # the bundled parameter file for URDF robots, as the README runs it
-    return base + ['--ros-args', '--params-file',
-                   os.path.join(PARAMS_DIR, 'urdf.yaml'),
-                   '-p', 'base_link:=base_link', '-p', 'tip_link:=tool0',
-                   '-p', 'log_throttle:=0.01', *extra]
+    return id_node_cmd('urdf.yaml', '-p', 'base_link:=base_link',
+                       '-p', 'tip_link:=tool0', '-p', 'log_throttle:=0.01',
+                       *extra)
 
 
 def with_sensor(urdf_text):

@@ -53,6 +53,23 @@ class Note(str):
     """
 
 
+def triangle_note(where, eig):
+    """
+    Return a Note when principal moments break the triangle inequality.
+
+    ``eig``: the three principal moments, ascending.  No real body has
+    such moments, but published models do (the Puma 560's link 1): they
+    are accepted as published, with this note.
+    """
+    tol = 1e-9 * max(eig[2], 1e-300)
+    if eig[0] + eig[1] < eig[2] - tol:
+        return Note(f'{where}: principal moments {eig[0]:.6g}, '
+                    f'{eig[1]:.6g}, {eig[2]:.6g} break the triangle '
+                    f'inequality (no real body has them); accepted as '
+                    f'published')
+    return None
+
+
 class RobotFileWarning(UserWarning):
     """A robot file is accepted but something in it is suspicious."""
 
@@ -384,13 +401,9 @@ def robot_from_dict(data, origin='<robot>'):
         cols['com'].append(com)
         inertia, eig = _inertia(link['inertia'], f'{where}: inertia')
         cols['inertia'].append(inertia)
-        tol = 1e-9 * max(eig[2], 1e-300)
-        if eig[0] + eig[1] < eig[2] - tol:
-            found.append(Note(
-                f'{where}: inertia: principal moments '
-                f'{eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} break the '
-                f'triangle inequality (no real body has them); accepted '
-                f'as published'))
+        note = triangle_note(f'{where}: inertia', eig)
+        if note:
+            found.append(note)
         if mass == 0.0 and any(c != 0.0 for c in com):
             found.append(f'{where}: com: given for a link of zero mass; '
                          f'it has no effect')

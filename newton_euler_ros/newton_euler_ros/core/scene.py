@@ -211,8 +211,8 @@ def _reference(block, n, q0, where):
         duration = to_number(block.get('duration'), f'{where}.duration')
         if duration <= 0.0:
             raise RobotFileError(f'{where}.duration: must be > 0')
-        return Reference('quintic', start, goal, duration, zeros, zeros,
-                         zeros)
+        return Reference('quintic', start, goal, duration, np.zeros(n),
+                         np.zeros(n), np.zeros(n))
     if kind == 'sinusoid':
         offset = (np.array(to_vector(block['offset'], n, f'{where}.offset'))
                   if 'offset' in block else q0.copy())
@@ -281,7 +281,7 @@ def scene_from_dict(data, origin, base_dir='.'):
 
     friction_on, block = _flag_or_block(eff.get('friction'),
                                         f'{w}.friction')
-    viscous = coulomb = np.zeros(n)
+    viscous, coulomb = np.zeros(n), np.zeros(n)   # two arrays, not one
     if friction_on:
         if not isinstance(block, dict):
             raise RobotFileError(f'{w}.friction: must give viscous and/or '

@@ -247,7 +247,10 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
     method = integrator or scene.integrator
     dt = step or scene.step
     T = scene.duration if duration is None else duration
-    steps = int(round(T / dt))
+    if not T > 0.0:
+        raise ValueError(f'duration must be > 0 s, got {T}')
+    # at least one step: a duration under half a step is one step, not none
+    steps = max(1, int(round(T / dt)))
     n = scene.model.n
     q, qd = scene.q0.astype(float).copy(), scene.qd0.astype(float).copy()
     out_t = np.arange(steps + 1) * dt

@@ -96,22 +96,9 @@ def read_urdf_text(text_or_path, label=None):
                 f'{label}: {len(text)} characters, more than the '
                 f'{MAX_BYTES} accepted')
         return text, label
-    path = text
-    label = label or os.path.basename(path)
-    if os.path.isdir(path):
-        raise RobotFileError(f'{path}: is a directory, not a URDF file')
-    try:
-        size = os.path.getsize(path)
-        if size > MAX_BYTES:
-            raise RobotFileError(f'{path}: {size} bytes, more than the '
-                                 f'{MAX_BYTES} accepted for a URDF file')
-        with open(path, 'rb') as fh:
-            data = fh.read(MAX_BYTES + 1)
-    except OSError as exc:
-        raise RobotFileError(f'{path}: cannot read: {exc.strerror}') from None
-    if not data.strip():
-        raise RobotFileError(f'{label}: the file is empty')
-    return _decode(data, label), label
+    from .robot_file import read_text
+    return read_text(text, MAX_BYTES, 'URDF file'), label or \
+        os.path.basename(text)
 
 
 def _decode(data, label):
@@ -478,7 +465,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     """
-    from .robot_file import Note
+    from .robot_file import triangle_note
     name, root, links, joints = parse_urdf(text, label)
     found = []
     base = root if base is None else base
@@ -580,13 +567,10 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
             lk = links[lname]
             if lk.has_inertial:
                 eig = lk.eig
-                tol = 1e-9 * max(eig[2], 1e-300)
-                if eig[0] + eig[1] < eig[2] - tol:
-                    found.append(Note(
-                        f'{label}: link {lname!r} <inertia>: principal '
-                        f'moments {eig[0]:.6g}, {eig[1]:.6g}, {eig[2]:.6g} '
-                        f'break the triangle inequality (no real body has '
-                        f'them); accepted as published'))
+                note = triangle_note(f'{label}: link {lname!r} <inertia>',
+                                     eig)
+                if note:
+                    found.append(note)
     limits = []
     for jname in moving:
         lim = {}

@@ -77,6 +77,30 @@ def declare(node, name, default, description):
         description=description)).value
 
 
+def _libc_trim():
+    try:
+        import ctypes
+        return ctypes.CDLL('libc.so.6').malloc_trim
+    except (OSError, AttributeError):        # not glibc: nothing to do
+        return None
+
+
+_MALLOC_TRIM = _libc_trim()
+
+
+def release_memory():
+    """
+    Give freed heap back to the operating system (glibc ``malloc_trim``).
+
+    Under a flood of messages the EventsExecutor queues one small handler
+    per message it has not yet run; once the flood is over they are freed,
+    but glibc keeps the pages, so the process' RSS would stay at its peak.
+    Nodes call this from their periodic timer: about 0.1 ms.
+    """
+    if _MALLOC_TRIM is not None:
+        _MALLOC_TRIM(0)
+
+
 def make_executor():
     """Return the executor to spin with (EventsExecutor when available)."""
     if os.environ.get('NEWTON_EULER_EXECUTOR') != 'single_threaded':

@@ -52,7 +52,7 @@ from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (ConfigurationError, declare_parameter, qos_profile,
-                     run_node)
+                     release_memory, run_node)
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
 from ..core.trajectory import trajectory_efforts
@@ -159,8 +159,12 @@ class InverseDynamicsNode(Node):
                                               '~/trajectory_out', 10)
         self.create_subscription(JointTrajectory, '~/trajectory_in',
                                  self._on_trajectory, 10)
+        # a deep request queue: a burst of callers must not be dropped by
+        # DDS before the node sees them (the default depth is 10)
+        service_qos = QoSProfile(depth=p['service.depth'],
+                                 reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(ComputeDynamics, '~/compute_dynamics',
-                            self._on_compute_dynamics)
+                            self._on_compute_dynamics, qos_profile=service_qos)
         if p['diagnostics_period'] > 0.0:
             self.diag_pub = self.create_publisher(DiagnosticArray,
                                                   '/diagnostics', 10)
@@ -521,6 +525,7 @@ class InverseDynamicsNode(Node):
         return response
 
     def _publish_counts(self):
+        release_memory()
         ff = self.ff
         status = DiagnosticStatus(
             level=DiagnosticStatus.OK if ff is not None
