@@ -19,11 +19,13 @@ See :mod:`newton_euler_ros.core.dynamics` for the functions, one per term
 of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``, and
 :mod:`newton_euler_ros.core.float32` for the same in single precision.
 """
-from .dynamics import (coriolis_matrix, end_effector_pose, forward_dynamics,
-                       gravity_torques, inverse_dynamics,
+from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
+                       end_effector_pose, forward_dynamics,
+                       forward_dynamics_batch, gravity_torques,
+                       gravity_torques_batch, inverse_dynamics,
                        inverse_dynamics_batch, jacobian, link_poses,
-                       mass_matrix, mass_matrix_condition,
-                       velocity_products, Workspace, wrench_torques)
+                       mass_matrix, mass_matrix_batch, mass_matrix_condition,
+                       velocity_products, wrench_torques)
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
 from .float32 import Float32Dynamics
@@ -31,13 +33,16 @@ from .model import make_model, pose_matrix, RobotModel, rpy_matrix
 from .robot_file import (bundled_robots, inspect_robot, load_robot,
                          robot_from_dict, RobotFileWarning)
 
+from .workspace import Workspace
+
 __all__ = [
-    'DynamicsInputError', 'Float32Dynamics', 'NewtonEulerError', 'NotPositiveDefiniteError',
-    'RobotFileError', 'RobotFileWarning', 'RobotModel', 'Workspace',
-    'bundled_robots', 'coriolis_matrix', 'end_effector_pose',
-    'forward_dynamics', 'gravity_torques', 'inspect_robot',
-    'inverse_dynamics', 'inverse_dynamics_batch', 'jacobian', 'link_poses',
-    'load_robot', 'make_model', 'mass_matrix', 'mass_matrix_condition',
-    'pose_matrix',
+    'DynamicsInputError', 'Float32Dynamics', 'NewtonEulerError',
+    'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
+    'RobotModel', 'Workspace', 'bundled_robots', 'coriolis_matrix',
+    'coriolis_matrix_batch', 'end_effector_pose', 'forward_dynamics',
+    'forward_dynamics_batch', 'gravity_torques', 'gravity_torques_batch',
+    'inspect_robot', 'inverse_dynamics', 'inverse_dynamics_batch',
+    'jacobian', 'link_poses', 'load_robot', 'make_model', 'mass_matrix',
+    'mass_matrix_batch', 'mass_matrix_condition', 'pose_matrix',
     'robot_from_dict', 'rpy_matrix', 'velocity_products', 'wrench_torques',
 ]

@@ -22,21 +22,16 @@ which every intermediate is a float32 (the test suite checks numba's type
 maps for that): this is genuine single-precision arithmetic, not float64
 arithmetic rounded at the end.
 
-What float32 buys here: almost nothing in time, for about nine fewer
-digits.  The recursion is scalar code over 3-tuples (no loop numba can
-vectorize), so a float32 operation costs what a float64 one costs; only
-the workspace traffic shrinks.  Measured on x86-64 (warm, min of 7
-repeats), raw kernels float32 vs float64: puma560 tau 1.22 vs 1.28 us,
-D 1.46 vs 1.53 us (n recursions) and 0.75 vs 0.81 us (CRBA); a random
-50-joint chain tau 3.05 vs 3.30 us.  From Python (these methods vs the
-float64 functions) tau is 2.2 vs 2.4 us and C 3.6 vs 3.7 us on the
-puma560: within 10%, about the timing noise, and passing float64 arrays
-instead of float32 ones costs about 0.45 us per argument for the
-conversion.  The relative error against the 50-digit reference is about
-1e-7 to 7e-7 for tau, D, C and g on the puma560 and panda (a few float32
-ulp; the tests bound it by 100 n eps32) instead of about 2e-16.  Its
-use is to measure what single precision costs in accuracy (embedded
-targets, GPUs), not to go faster.
+What float32 buys here: nothing in time, for about nine fewer digits.
+The kernels are scalar code over 3-tuples (no loop numba can vectorize),
+so a float32 operation costs what a float64 one costs, and from Python
+these methods are slower than the float64 functions, which have a
+faster entry path (``make accuracy`` times both: 0.9x to 2.3x).  The
+relative error against the 50-digit reference is about 1e-7 to 7e-7 for
+tau, D, C and g on the puma560 and panda (a few float32 ulp; the tests
+bound it by 100 n eps32) instead of about 2e-16; forward dynamics
+amplifies it by up to cond(D).  Its use is to measure what single
+precision costs in accuracy (embedded targets, GPUs), not to go faster.
 
 Error budget.  Three roundings make up the float32 error, and all three
 are part of it by design: the model's parameters (DH values and their
@@ -64,13 +59,14 @@ import math
 import numpy as np
 
 from . import _kernels as K
-from .dynamics import (_bad_method, _raise_nonfinite, _vector,
-                       _WRENCH_FRAMES)
+from .dynamics import (_bad_method, _FD_INPUTS, _INPUTS,
+                       _not_positive_definite, _raise_nonfinite, _vector,
+                       _wrench_mode, CORIOLIS_METHODS)
 from .errors import DynamicsInputError
+from .workspace import Workspace
 
 _F32 = np.float32
 _F32_MAX = float(np.finfo(np.float32).max)
-_ARG_NAMES = ('q', 'qd', 'qdd', 'wrench')
 
 
 def _readonly32(x):
@@ -89,7 +85,7 @@ def _out(out):
     return out
 
 
-def _raise(code, rounded, given):
+def _raise(code, rounded, given, names=_INPUTS):
     """Raise for a bad input, naming float32 overflow as such."""
     if code != K.OVERFLOW:
         arg, i = divmod(code, 1000)
@@ -98,9 +94,9 @@ def _raise(code, rounded, given):
                                               dtype=np.float64))[i])
             if math.isfinite(value):
                 raise DynamicsInputError(
-                    f'{_ARG_NAMES[arg]}[{i}] is {value!r}, outside the '
+                    f'{names[arg]}[{i}] is {value!r}, outside the '
                     f'float32 range (|x| <= {_F32_MAX:.8g})')
-    _raise_nonfinite(code, rounded, 'float32')
+    _raise_nonfinite(code, rounded, 'float32', names)
 
 
 class Float32Dynamics:
@@ -123,12 +119,10 @@ class Float32Dynamics:
         n = model.n
         self.model = model
         self.n = n
-        self.links = _readonly32(model.links_array)
-        self.frames = _readonly32(model.frames_array)
-        self._ws = np.zeros((n, K.W_WIDTH), dtype=_F32)
-        self._scratch = np.zeros((3, n), dtype=_F32)
-        self._zeros = np.zeros(n, dtype=_F32)
-        self._zero_wrench = np.zeros(6, dtype=_F32)
+        self.packed = _readonly32(model.packed)
+        self._ws = Workspace(model, _F32)
+        self._zeros = self._ws.zeros
+        self._zero_wrench = self._ws.zero_wrench
         # buffers for inputs that arrive as anything but float32 vectors
         self._in = (np.zeros(n, dtype=_F32), np.zeros(n, dtype=_F32),
                     np.zeros(n, dtype=_F32), np.zeros(6, dtype=_F32))
@@ -140,17 +134,17 @@ class Float32Dynamics:
     # ------------------------------------------------------------------
     # argument handling (the float64 helpers, plus the rounding)
 
-    def _vec(self, arg, x, size):
+    def _vec(self, arg, x, size, names=_INPUTS):
         """Return x as a float32 vector of ``size`` entries, or raise."""
         if (type(x) is np.ndarray and x.dtype == _F32 and x.ndim == 1
                 and x.flags.c_contiguous):
             if x.shape[0] != size:
                 raise DynamicsInputError(
-                    f'{_ARG_NAMES[arg]} must have {size} entries, '
+                    f'{names[arg]} must have {size} entries, '
                     f'got {x.shape[0]}')
             return x
         buf = self._in[arg]
-        K.round_into(_vector(_ARG_NAMES[arg], x, size), buf)
+        K.round_into(_vector(names[arg], x, size), buf)
         return buf
 
     # ------------------------------------------------------------------
@@ -170,19 +164,13 @@ class Float32Dynamics:
         q32 = self._vec(0, q, n)
         qd32 = self._zeros if qd is None else self._vec(1, qd, n)
         qdd32 = self._zeros if qdd is None else self._vec(2, qdd, n)
-        if wrench is None:
-            w32, mode = self._zero_wrench, K.WRENCH_NONE
-        else:
-            mode = _WRENCH_FRAMES.get(wrench_frame)
-            if mode is None:
-                raise DynamicsInputError(
-                    f"wrench_frame must be 'base' or 'end_effector', "
-                    f'got {wrench_frame!r}')
-            w32 = self._vec(3, wrench, 6)
+        mode = _wrench_mode(wrench, wrench_frame)
+        w32 = (self._zero_wrench if wrench is None
+               else self._vec(3, wrench, 6))
         tau = np.empty(n, dtype=_F32) if out is None else _out(out)
-        bad = K.inverse_dynamics(self.links, self.frames, q32, qd32, qdd32,
-                                 w32, gravity, velocity_products, mode,
-                                 self._ws, tau)
+        bad = K.run_inverse_dynamics(
+            self.packed, q32, qd32, qdd32, w32,
+            K.flags(gravity, velocity_products, mode), self._ws.ws, tau)
         if bad >= 0:
             _raise(bad, (q32, qd32, qdd32, w32), (q, qd, qdd, wrench))
         return tau
@@ -202,21 +190,24 @@ class Float32Dynamics:
         if bad >= 0:
             _raise(bad, (q32, zeros, zeros, zeros), (q, None, None, None))
         D = np.empty((n, n), dtype=_F32) if out is None else _out(out)
-        if method == 'newton_euler':
-            bad = K.mass_matrix(self.links, self.frames, q32, self._ws,
-                                self._scratch, D)
-        elif method == 'crba':
-            bad = K.mass_matrix_crba(self.links, self.frames, q32, self._ws,
-                                     D)
-        else:
+        if method not in ('newton_euler', 'crba'):
             raise _bad_method(method)
-        if bad >= 0:
+        if K.run_mass_matrix(self.packed, q32, method == 'crba', self._ws.ws,
+                             self._ws.scratch, D) >= 0:
             _raise_nonfinite(K.OVERFLOW, (), 'float32')
         return D
 
-    def coriolis_matrix(self, q, qd, *, out=None):
-        """Christoffel C(q, qd), (n, n) float32; n recursions."""
+    def coriolis_matrix(self, q, qd, *, method='composite', out=None):
+        """
+        Christoffel C(q, qd), (n, n) float32.
+
+        ``method`` is ``'composite'`` (O(n^2), the default) or
+        ``'newton_euler'`` (n recursions), as in
+        :func:`~newton_euler_ros.core.dynamics.coriolis_matrix`.
+        """
         n = self.n
+        if method not in CORIOLIS_METHODS:
+            raise _bad_method(method, CORIOLIS_METHODS)
         q32 = self._vec(0, q, n)
         qd32 = self._vec(1, qd, n)
         zeros = self._zeros
@@ -224,10 +215,40 @@ class Float32Dynamics:
         if bad >= 0:
             _raise(bad, (q32, qd32, zeros, zeros), (q, qd, None, None))
         C = np.empty((n, n), dtype=_F32) if out is None else _out(out)
-        if K.coriolis_matrix(self.links, self.frames, q32, qd32, self._ws,
-                             self._scratch, C) >= 0:
+        if K.run_coriolis_matrix(self.packed, q32, qd32, method == 'composite',
+                                 self._ws.ws, self._ws.cw, self._ws.scratch,
+                                 C) >= 0:
             _raise_nonfinite(K.OVERFLOW, (), 'float32')
         return C
+
+    def forward_dynamics(self, q, qd, tau, wrench=None, wrench_frame='base',
+                         *, out=None):
+        """
+        Joint accelerations in float32, by the articulated-body algorithm.
+
+        Arguments as :func:`~newton_euler_ros.core.dynamics.forward_dynamics`;
+        raises :class:`~newton_euler_ros.core.errors.NotPositiveDefiniteError`
+        where D is singular.
+        """
+        n = self.n
+        q32 = self._vec(0, q, n)
+        qd32 = self._vec(1, qd, n)
+        tau32 = self._vec(2, tau, n, _FD_INPUTS)
+        mode = _wrench_mode(wrench, wrench_frame)
+        w32 = (self._zero_wrench if wrench is None
+               else self._vec(3, wrench, 6))
+        qdd = np.empty(n, dtype=_F32) if out is None else _out(out)
+        bad = K.run_forward_dynamics(self.packed, q32, qd32, tau32, w32,
+                                     K.flags(True, True, mode), self._ws.ws,
+                                     self._ws.aw, qdd)
+        if bad >= K.SINGULAR:
+            raise _not_positive_definite(self.model, np.asarray(q, float),
+                                         bad - K.SINGULAR,
+                                         self.model.default_workspace)
+        if bad >= 0:
+            _raise(bad, (q32, qd32, tau32, w32), (q, qd, tau, wrench),
+                   _FD_INPUTS)
+        return qdd
 
     def gravity_torques(self, q, *, out=None):
         """g(q) in float32: the joint torques that hold the arm still."""

@@ -35,7 +35,8 @@ import mpmath
 import numpy as np
 
 from . import _kernels as K
-from .dynamics import _bad_method, MASS_MATRIX_METHODS
+from .dynamics import (_bad_method, CORIOLIS_METHODS,
+                       FORWARD_DYNAMICS_METHODS, MASS_MATRIX_METHODS)
 from .model import compile_arrays
 
 _SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
@@ -146,21 +147,67 @@ class HighPrecisionModel:
                               scratch, D)
         return D
 
-    def coriolis_matrix(self, q, qd):
-        """Return the Christoffel C(q, qd) as an object array of mpf."""
+    def coriolis_matrix(self, q, qd, method='newton_euler'):
+        """
+        Return the Christoffel C(q, qd) as an object array of mpf.
+
+        ``method`` as in :func:`~newton_euler_ros.core.dynamics.coriolis_matrix`:
+        ``'newton_euler'`` (n recursions, the default here: the reference)
+        or ``'composite'`` (the O(n^2) algorithm, to measure it).
+        """
         n = self.model.n
+        if method not in CORIOLIS_METHODS:
+            raise _bad_method(method, CORIOLIS_METHODS)
         with mpmath.workdps(self.dps):
             ws = np.empty((n, K.W_WIDTH), dtype=object)
-            scratch = np.empty((3, n), dtype=object)
             C = np.empty((n, n), dtype=object)
-            _MP.joint_trig(self.links, self.frames, self._vec(q, n), ws)
+            qv, qdv = self._vec(q, n), self._vec(qd, n)
+            if method == 'composite':
+                cw = np.empty((n + 1, K.CW_WIDTH), dtype=object)
+                _MP.coriolis_matrix_composite(self.links, self.frames, qv,
+                                              qdv, ws, cw, C)
+                return C
+            scratch = np.empty((3, n), dtype=object)
+            _MP.joint_trig(self.links, self.frames, qv, ws)
             zero = mpmath.mpf(0)
             for i in range(3):
                 for k in range(n):
                     scratch[i, k] = zero
-            _MP._unit_columns(self.links, self.frames, self._vec(qd, n),
-                              True, ws, scratch, C)
+            _MP._unit_columns(self.links, self.frames, qdv, True, ws,
+                              scratch, C)
         return C
+
+    def forward_dynamics(self, q, qd, tau, wrench=None, wrench_frame='base',
+                         method='aba'):
+        """
+        Return qdd as an object array of mpf.
+
+        ``method='aba'``: the articulated-body kernel at this precision;
+        ``'cholesky'``: D and the bias torques from the recursion, solved
+        by mpmath's LU (the independent reference).
+        """
+        n = self.model.n
+        if method not in FORWARD_DYNAMICS_METHODS:
+            raise _bad_method(method, FORWARD_DYNAMICS_METHODS)
+        mode = K.WRENCH_NONE if wrench is None else (
+            K.WRENCH_BASE if wrench_frame == 'base' else K.WRENCH_EE)
+        with mpmath.workdps(self.dps):
+            if method == 'cholesky':
+                D = self.mass_matrix(q, method='crba')
+                bias = self.inverse_dynamics(q, qd, None, wrench,
+                                             wrench_frame)
+                rhs = [self._vec(tau, n)[i] - bias[i] for i in range(n)]
+                x = mpmath.lu_solve(mpmath.matrix(D.tolist()),
+                                    mpmath.matrix(rhs))
+                return np.array([x[i] for i in range(n)], dtype=object)
+            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            aw = np.empty((n + 1, K.A_WIDTH), dtype=object)
+            qdd = np.empty(n, dtype=object)
+            _MP.articulated_body(self.links, self.frames, self._vec(q, n),
+                                 self._vec(qd, n), self._vec(tau, n),
+                                 self._vec(wrench, 6), True, True, mode, ws,
+                                 aw, qdd)
+        return qdd
 
 
 def relative_error(approx, exact):

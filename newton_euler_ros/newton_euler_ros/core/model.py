@@ -60,6 +60,7 @@ Frames and conventions (SI units throughout):
   tip link's frame).
 """
 from dataclasses import dataclass, field
+import functools
 import math
 
 import numpy as np
@@ -302,7 +303,9 @@ class RobotModel:
     tool : (4, 4) pose of the end-effector frame in link frame n
     limits : tuple of n dicts (keys among lower, upper, velocity, effort)
     info : dict of source details (e.g. URDF link names); not dynamics
-    links_array, frames_array : packed, read-only copies for the kernels
+    links_array, frames_array : read-only copies for the kernels
+    packed : both in one read-only array, as the kernels' entry points
+        take them (``_kernels.pack``)
 
     """
 
@@ -327,6 +330,7 @@ class RobotModel:
     info: dict = None
     links_array: np.ndarray = field(init=False, repr=False)
     frames_array: np.ndarray = field(init=False, repr=False)
+    packed: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         n = len(self.joint_names)
@@ -344,6 +348,19 @@ class RobotModel:
         object.__setattr__(self, 'links_array',
                            _readonly(np.reshape(links, (n, K.L_WIDTH))))
         object.__setattr__(self, 'frames_array', _readonly(frames))
+        object.__setattr__(self, 'packed', _readonly(
+            K.pack(self.links_array, self.frames_array)))
+
+    @functools.cached_property
+    def default_workspace(self):
+        """
+        Return the workspace every dynamics call without ``ws=`` uses.
+
+        Created on first use and shared by all such calls on this model:
+        not thread-safe (give each thread its own ``Workspace(model)``).
+        """
+        from .workspace import Workspace
+        return Workspace(self)
 
     @property
     def n(self):

@@ -31,11 +31,19 @@ import time
 
 import numpy as np
 
-from . import _kernels as K
 from .dynamics import (inverse_dynamics, jacobian, link_poses, mass_matrix,
-                       Workspace)
-from .errors import NotPositiveDefiniteError
+                       solve_mass_matrix, Workspace)
 from .scene import INTEGRATORS
+
+
+def pd_torque(scene, q_d, qd_d, q, qd):
+    """Return the scene's PD law, kp (q_d - q) + kd (qd_d - qd)."""
+    return scene.kp * (q_d - q) + scene.kd * (qd_d - qd)
+
+
+def friction_torque(scene, qd):
+    """Friction torque the joints lose: viscous qd + Coulomb sign(qd)."""
+    return scene.viscous * qd + scene.coulomb * np.sign(qd)
 
 
 class SceneDynamics:
@@ -47,8 +55,6 @@ class SceneDynamics:
         self.effects = scene.effects
         self.ws = Workspace(scene.model)
         n = scene.model.n
-        self._L = np.zeros((n, n))
-        self._qdd = np.zeros(n)
         self._D = np.zeros((n, n))
         self.live_wrench = np.zeros(6)
         self.live_frame = (scene.wrench.frame if scene.wrench is not None
@@ -69,8 +75,8 @@ class SceneDynamics:
         return self.scene.wrench.at(t), self.scene.wrench.frame
 
     def friction(self, qd):
-        """Friction torque the joints lose: viscous qd + Coulomb sign(qd)."""
-        return self.scene.viscous * qd + self.scene.coulomb * np.sign(qd)
+        """Friction torque the joints lose (:func:`friction_torque`)."""
+        return friction_torque(self.scene, qd)
 
     def torques(self, q, qd, qdd, t):
         """Inverse dynamics with exactly the scene's effects at time t."""
@@ -98,26 +104,22 @@ class SceneDynamics:
             tau += self.friction(qd)
         return tau
 
+    def mass_matrix(self, q, out=None):
+        """D(q), plus the rotor inertia on its diagonal with armature."""
+        D = mass_matrix(self.model, q, ws=self.ws, out=out)
+        if self.effects.armature:
+            D.flat[::D.shape[0] + 1] += self.scene.armature
+        return D
+
     def accelerations(self, q, qd, tau, t):
         """Forward dynamics: qdd for applied torques ``tau``."""
         bias = self.torques(q, qd, np.zeros_like(q), t)
-        D = mass_matrix(self.model, q, ws=self.ws, out=self._D)
-        if self.effects.armature:
-            D.flat[::D.shape[0] + 1] += self.scene.armature
-        qdd = np.empty_like(q)
-        bad = K.cholesky_solve(D, tau - bias, self._L, qdd)
-        if bad >= 0:
-            raise NotPositiveDefiniteError(
-                f'the mass matrix is not positive definite at joint {bad} '
-                f'({self.model.joint_names[bad]})', bad)
-        return qdd
+        D = self.mass_matrix(q, out=self._D)
+        return solve_mass_matrix(self.model, q, D, tau - bias, ws=self.ws)
 
     def energy(self, q, qd):
         """Kinetic (with rotor inertia) plus gravitational potential."""
-        D = mass_matrix(self.model, q, ws=self.ws, out=self._D)
-        T = 0.5 * qd @ D @ qd
-        if self.effects.armature:
-            T += 0.5 * np.sum(self.scene.armature * qd * qd)
+        T = 0.5 * qd @ self.mass_matrix(q, out=self._D) @ qd
         U = 0.0
         if self.effects.gravity:
             poses = link_poses(self.model, q, ws=self.ws)
@@ -139,31 +141,51 @@ class SceneDynamics:
         return p_tau, p_f, p_w
 
 
+def advance(method, accel, q, qd, t, h, power=None):
+    """
+    Return (q, qd, work) one step of ``h`` later: the one integrator step.
+
+    ``accel(t, q, qd)`` gives the accelerations (the torques are held over
+    the step by the caller).  ``method`` is 'rk4' (four calls) or
+    'semi_implicit_euler' (one: qd first, then q with the new qd).  With
+    ``power(t, q, qd)``, ``work`` is its integral over the step by the same
+    rule (RK4's weights; the end state for semi-implicit Euler), else 0.
+    """
+    if method == 'rk4':
+        a1 = accel(t, q, qd)
+        q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
+        a2 = accel(t + 0.5 * h, q2, v2)
+        q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
+        a3 = accel(t + 0.5 * h, q3, v3)
+        q4, v4 = q + h * v3, qd + h * a3
+        a4 = accel(t + h, q4, v4)
+        work = 0.0
+        if power is not None:
+            work = h / 6.0 * (power(t, q, qd) + 2 * power(t + 0.5 * h, q2, v2)
+                              + 2 * power(t + 0.5 * h, q3, v3)
+                              + power(t + h, q4, v4))
+        return (q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4),
+                qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4), work)
+    if method == 'semi_implicit_euler':
+        qd = qd + h * accel(t, q, qd)
+        q = q + h * qd
+        work = 0.0 if power is None else h * power(t + h, q, qd)
+        return q, qd, work
+    raise ValueError(f'integrator must be one of {", ".join(INTEGRATORS)}, '
+                     f'got {method!r}')
+
+
 def integrator_step(dyn, method, q, qd, tau, t, h):
     """
     Return (q, qd) one step of ``h`` later, holding the torques ``tau``.
 
-    ``method`` is 'rk4' (four forward-dynamics calls) or
-    'semi_implicit_euler' (one).  The stepping of the simulator node and
-    of the integrator measurements; :func:`simulate` does the same
-    arithmetic and also integrates the power for its energy bookkeeping.
+    The stepping of the simulator node and of the integrator
+    measurements: :func:`step` on the scene's forward dynamics.
     """
-    acc = dyn.accelerations
-    if method == 'rk4':
-        a1 = acc(q, qd, tau, t)
-        q2, v2 = q + 0.5 * h * qd, qd + 0.5 * h * a1
-        a2 = acc(q2, v2, tau, t + 0.5 * h)
-        q3, v3 = q + 0.5 * h * v2, qd + 0.5 * h * a2
-        a3 = acc(q3, v3, tau, t + 0.5 * h)
-        q4, v4 = q + h * v3, qd + h * a3
-        a4 = acc(q4, v4, tau, t + h)
-        return (q + h / 6.0 * (qd + 2 * v2 + 2 * v3 + v4),
-                qd + h / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4))
-    if method == 'semi_implicit_euler':
-        qd = qd + h * acc(q, qd, tau, t)
-        return q + h * qd, qd
-    raise ValueError(f'integrator must be one of {", ".join(INTEGRATORS)}, '
-                     f'got {method!r}')
+    q, qd, _ = advance(method,
+                       lambda t, q, qd: dyn.accelerations(q, qd, tau, t),
+                       q, qd, t, h)
+    return q, qd
 
 
 FEEDFORWARD_AT = ('desired', 'measured')
@@ -193,7 +215,7 @@ def tracking_controller(dyn, feedforward=None, feedforward_at='desired'):
 
     def control(t, q, qd):
         q_d, qd_d, qdd_d = scene.reference.at(t)
-        tau = scene.kp * (q_d - q) + scene.kd * (qd_d - qd)
+        tau = pd_torque(scene, q_d, qd_d, q, qd)
         if not use_ff:
             ff = np.zeros_like(q)
         elif measured:
@@ -271,10 +293,9 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
         except ImportError:
             bar = None
 
-    def deriv(t, q, qd, tau):
-        qdd = dyn.accelerations(q, qd, tau, t)
-        return qdd, np.array(dyn.power(q, qd, tau, t))
-
+    if method not in INTEGRATORS:
+        raise ValueError(f'integrator must be one of '
+                         f'{", ".join(INTEGRATORS)}, got {method!r}')
     start = time.perf_counter()
     for k in range(steps + 1):
         t = k * dt
@@ -286,22 +307,10 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
             break
         tau, ff = control(t, q, qd)
         out_tau[k], out_ff[k] = tau, ff
-        if method == 'rk4':
-            a1, p1 = deriv(t, q, qd, tau)
-            q2, v2 = q + 0.5 * dt * qd, qd + 0.5 * dt * a1
-            a2, p2 = deriv(t + 0.5 * dt, q2, v2, tau)
-            q3, v3 = q + 0.5 * dt * v2, qd + 0.5 * dt * a2
-            a3, p3 = deriv(t + 0.5 * dt, q3, v3, tau)
-            q4, v4 = q + dt * v3, qd + dt * a3
-            a4, p4 = deriv(t + dt, q4, v4, tau)
-            q = q + dt / 6.0 * (qd + 2 * v2 + 2 * v3 + v4)
-            qd = qd + dt / 6.0 * (a1 + 2 * a2 + 2 * a3 + a4)
-            work = work + dt / 6.0 * (p1 + 2 * p2 + 2 * p3 + p4)
-        else:   # semi-implicit (symplectic) Euler
-            a1, _ = deriv(t, q, qd, tau)
-            qd = qd + dt * a1
-            q = q + dt * qd
-            work = work + dt * np.array(dyn.power(q, qd, tau, t + dt))
+        q, qd, w = advance(
+            method, lambda t, q, qd: dyn.accelerations(q, qd, tau, t), q, qd,
+            t, dt, lambda t, q, qd: np.array(dyn.power(q, qd, tau, t)))
+        work = work + w
         if bar is not None:
             bar.update(1)
     if bar is not None:

@@ -39,7 +39,6 @@ import atexit
 import json
 import math
 import os
-import sys
 import warnings
 
 from hypothesis import given, settings
@@ -54,9 +53,7 @@ from newton_euler_ros.core import (bundled_robots, coriolis_matrix,
 from newton_euler_ros.core.model import convert_convention
 import numpy as np
 import pytest
-
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import reference_dynamics as ref  # noqa: E402
+import reference_dynamics as ref    # test/, on sys.path (conftest.py)
 
 BUNDLED = ['panda', 'planar_2r', 'planar_rp', 'puma560', 'scara', 'stanford']
 CONVENTIONS = ['standard', 'modified']

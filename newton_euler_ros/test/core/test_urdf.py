@@ -315,7 +315,7 @@ PUBLISHED = [
 @pytest.mark.parametrize('relative,tip', PUBLISHED)
 def test_published_urdf_matches_pinocchio(relative, tip):
     pytest.importorskip('pinocchio')
-    from newton_euler_ros.peers import example_robot_urdf, PinocchioUrdf
+    from newton_euler_tools.peers import example_robot_urdf, PinocchioUrdf
     try:
         path = example_robot_urdf(relative)
     except ImportError:

@@ -33,7 +33,8 @@ import warnings
 import mpmath
 from newton_euler_ros.core import _kernels as K
 from newton_euler_ros.core import (bundled_robots, DynamicsInputError,
-                                   load_robot, make_model, mass_matrix)
+                                   load_robot, make_model, mass_matrix,
+                                   mass_matrix_condition)
 from newton_euler_ros.core import float32 as float32_module
 from newton_euler_ros.core.float32 import Float32Dynamics
 from newton_euler_ros.core.highprec import HighPrecisionModel, relative_error
@@ -245,8 +246,35 @@ def _run_every_kernel(mod, model, dtype):
                                     mode, ws, tau) == -1
     Q = np.tile(q, (3, 1))
     TAU = np.zeros((3, n), f)
-    mod.inverse_dynamics_batch(links, frames, Q, Q, Q, np.zeros((3, 6), f),
-                               True, True, mod.WRENCH_NONE, ws, TAU)
+    W = np.zeros((3, 6), f)
+    status = np.zeros(1, np.int64)
+    P = mod.pack(links, frames)
+    aw = np.zeros((n + 1, mod.A_WIDTH), f)
+    cw = np.zeros((n + 1, mod.CW_WIDTH), f)
+    Ts = np.zeros((n + 2, 12), f)
+    J = np.zeros((6, n), f)
+    for mode in (mod.WRENCH_NONE, mod.WRENCH_BASE, mod.WRENCH_EE):
+        flags = mod.flags(True, True, mode)
+        assert mod.run_inverse_dynamics(P, q, q, q, w, flags, ws, tau) == -1
+        assert mod.run_forward_dynamics(P, q, q, q, w, flags, ws, aw,
+                                        tau) == -1
+    assert mod.run_gravity_torques(P, q, ws, tau) == -1
+    assert mod.run_mass_matrix_crba(P, q, ws, M) == -1
+    for method in (True, False):
+        assert mod.run_mass_matrix(P, q, method, ws, scratch, M) == -1
+        assert mod.run_coriolis_matrix(P, q, q, method, ws, cw, scratch,
+                                       M) == -1
+    assert mod.run_jacobian(P, q, True, ws, Ts, J) == -1
+    assert mod.run_link_poses(P, q, ws, Ts) == -1
+    flags = mod.flags(True, True, mod.WRENCH_NONE)
+    assert mod.run_inverse_dynamics_batch(P, Q, Q, Q, W, flags, ws, TAU,
+                                          status) == -1
+    assert mod.run_forward_dynamics_batch(P, Q, Q, Q, W, flags, ws, aw, TAU,
+                                          status) == -1
+    MM = np.zeros((3, n, n), f)
+    assert mod.run_mass_matrix_batch(P, Q, ws, MM, status) == -1
+    assert mod.run_gravity_torques_batch(P, Q, ws, TAU, status) == -1
+    assert mod.run_coriolis_matrix_batch(P, Q, Q, ws, cw, MM, status) == -1
     assert mod.mass_matrix(links, frames, q, ws, scratch, M) == -1
     D = M.copy()
     assert mod.mass_matrix_crba(links, frames, q, ws, M) == -1
@@ -313,7 +341,10 @@ def test_float32_errors_are_float32_sized(arm32):
                            hp.inverse_dynamics(q, qd, qdd, F, 'end_effector')),
             'D_ne': (f32.mass_matrix(q, method='newton_euler'), hp.mass_matrix(q)),
             'D_crba': (f32.mass_matrix(q, method='crba'), hp.mass_matrix(q)),
-            'C': (f32.coriolis_matrix(q, qd), hp.coriolis_matrix(q, qd)),
+            'C': (f32.coriolis_matrix(q, qd, method='newton_euler'),
+                  hp.coriolis_matrix(q, qd)),
+            'C_composite': (f32.coriolis_matrix(q, qd),
+                            hp.coriolis_matrix(q, qd)),
             'g': (f32.gravity_torques(q),
                   hp.inverse_dynamics(q, velocity_products=False)),
         }
@@ -322,6 +353,13 @@ def test_float32_errors_are_float32_sized(arm32):
             err = relative_error(approx, exact)
             errors[key] = max(errors.get(key, 0.0), err)
             assert low < err < high, (key, err, low, high)
+        # forward dynamics amplifies by up to cond(D): bound it so
+        tau = hp.inverse_dynamics(q, qd, qdd)
+        cond = mass_matrix_condition(model, q)
+        err = relative_error(f32.forward_dynamics(q, qd, np.array(
+            tau, dtype=float)), hp.forward_dynamics(q, qd, np.array(
+                tau, dtype=float), method='cholesky'))
+        assert low < err < high * cond, ('qdd', err, cond)
     # the same inputs as float32 arrays give the same results
     q32 = q.astype(np.float32)
     assert np.array_equal(f32.gravity_torques(q32), f32.gravity_torques(q))

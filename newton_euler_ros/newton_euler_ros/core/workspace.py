@@ -1,0 +1,52 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+
+"""Preallocated scratch memory for the kernels of one model size."""
+import numpy as np
+
+from . import _kernels as K
+
+
+class Workspace:
+    """
+    Scratch memory for one model; reuse it across calls.
+
+    Every dynamics function takes ``ws=``; without it they use the model's
+    own ``model.default_workspace``, one per model, shared by every call
+    that passes none.  Not thread-safe: give each thread its own
+    ``Workspace(model)``.  The kernels check its sizes against the model
+    they are called with, so a workspace of another size is refused.
+
+    ``dtype`` is the number type of the kernels it serves (float64, or
+    float32 for :class:`~newton_euler_ros.core.float32.Float32Dynamics`).
+    """
+
+    def __init__(self, model, dtype=np.float64):
+        n = model.n
+        self.n = n
+        self.dtype = np.dtype(dtype)
+        self.ws = np.zeros((n, K.W_WIDTH), dtype)
+        self.scratch = np.zeros((3, n), dtype)
+        self.frames = np.zeros((n + 2, 12), dtype)
+        self.chol = np.zeros((n, n), dtype)
+        self.aw = np.zeros((n + 1, K.A_WIDTH), dtype)
+        self.cw = np.zeros((n + 1, K.CW_WIDTH), dtype)
+        self.zeros = np.zeros(n, dtype)
+        self.zero_wrench = np.zeros(6, dtype)
+        self.status = np.zeros(1, np.int64)
+
+    def __repr__(self):
+        """Return e.g. ``Workspace(n=6, float64)``."""
+        return f'Workspace(n={self.n}, {self.dtype})'
