@@ -252,18 +252,30 @@ class WrenchInput:
 
     def current(self, now):
         """
-        (wrench or None, frame).
+        (wrench or None, frame) at ``now``; reading changes nothing.
 
-        A wrench older than the timeout is dropped (the torques are then
-        computed without it) and ``expired`` counts that event once.
+        A wrench older than the timeout is not returned (the torques are
+        then computed without it); :meth:`expire` drops and counts it.
         """
-        if self.wrench is None:
-            return None, self.frame
-        if self.timeout and now - self.stamp > self.timeout:
-            self.wrench = None
-            self.expired += 1
+        if self.wrench is None or self._too_old(now):
             return None, self.frame
         return self.wrench, self.frame
+
+    def expire(self, now):
+        """
+        Drop the wrench if it is older than the timeout at ``now``.
+
+        Return True when it expired by this call (``expired`` counts each
+        such event once), False otherwise.
+        """
+        if self.wrench is None or not self._too_old(now):
+            return False
+        self.wrench = None
+        self.expired += 1
+        return True
+
+    def _too_old(self, now):
+        return bool(self.timeout) and now - self.stamp > self.timeout
 
 
 MODES = ('gravity', 'gravity_coriolis', 'full')
@@ -501,13 +513,12 @@ class FeedforwardComputer:
         qdd = (np.zeros(n) if len(acceleration) == 0 else
                self.order.gather(names, 'acceleration', acceleration))
         w, frame = self.wrench.current(now)
-        D = mass_matrix(self.model, q, ws=self.ws)
+        D = (self.dyn.mass_matrix(q) if self.dyn is not None
+             else mass_matrix(self.model, q, ws=self.ws))
         C = coriolis_matrix(self.model, q, qd, ws=self.ws)
         g = gravity_torques(self.model, q, ws=self.ws)
         if self.scene is not None:      # the terms the scene has
             eff = self.scene.effects
-            if eff.armature:
-                D.flat[::D.shape[0] + 1] += self.scene.armature
             if not eff.velocity_products:
                 C[:] = 0.0
             if not eff.gravity:

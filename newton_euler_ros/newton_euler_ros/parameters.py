@@ -13,15 +13,17 @@
 # limitations under the License.
 
 """
-Node parameters from one schema file, without ROS.
+Node parameters from one schema file per node, without ROS.
 
-``inverse_dynamics_parameters.yaml`` (beside this module) lists every
-parameter with its type, default, description, ``read_only`` flag and
-validation rules, in the style of generate_parameter_library.  This module
-reads it, validates values and renders the README table; the node declares
-its parameters from the same :class:`ParameterSpec` list.
+``<node>_parameters.yaml`` beside this module (inverse_dynamics,
+robot_sim, tracking_controller) lists every parameter of that node with
+its type, default, description, ``read_only`` flag and validation rules,
+in the style of generate_parameter_library.  This module reads it,
+validates values and renders the README table; each node declares its
+parameters from the same :class:`ParameterSpec` list
+(:func:`..nodes.common.declare_parameters`).
 
-    python -m newton_euler_ros.parameters --markdown
+    python -m newton_euler_ros.parameters --markdown [NODE]
 """
 import math
 import os
@@ -29,8 +31,18 @@ import sys
 
 import yaml
 
-SCHEMA = os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                      'inverse_dynamics_parameters.yaml')
+HERE = os.path.dirname(os.path.abspath(__file__))
+NODES = ('inverse_dynamics_node', 'robot_sim_node', 'tracking_controller_node')
+
+
+def schema_path(node_name):
+    """Return the schema file of ``node_name`` (e.g. robot_sim_node)."""
+    base = node_name[:-len('_node')] if node_name.endswith('_node') \
+        else node_name
+    return os.path.join(HERE, f'{base}_parameters.yaml')
+
+
+SCHEMA = schema_path('inverse_dynamics_node')
 TYPES = {'string': str, 'double': float, 'int': int, 'bool': bool,
          'string_array': list, 'double_array': list}
 
@@ -38,11 +50,11 @@ TYPES = {'string': str, 'double': float, 'int': int, 'bool': bool,
 class ParameterSpec:
     """One declared parameter: name (dotted), type, default, rules."""
 
-    def __init__(self, name, entry):
+    def __init__(self, name, entry, path=SCHEMA):
         self.name = name
         self.type = entry['type']
         if self.type not in TYPES:
-            raise ValueError(f'{SCHEMA}: {name}: unknown type {self.type!r}')
+            raise ValueError(f'{path}: {name}: unknown type {self.type!r}')
         self.default = entry['default_value']
         self.description = entry['description']
         self.read_only = bool(entry.get('read_only', False))
@@ -107,20 +119,21 @@ _RULES = {'one_of<>': _one_of, 'gt<>': _gt, 'gt_eq<>': _gt_eq,
           'fixed_size<>': _fixed_size}
 
 
-def _flatten(tree, prefix=''):
+def _flatten(tree, path, prefix=''):
     for key, entry in tree.items():
         name = f'{prefix}{key}'
         if isinstance(entry, dict) and 'type' in entry:
-            yield ParameterSpec(name, entry)
+            yield ParameterSpec(name, entry, path)
         else:
-            yield from _flatten(entry, name + '.')
+            yield from _flatten(entry, path, name + '.')
 
 
-def load_specs(node_name='inverse_dynamics_node', path=SCHEMA):
+def load_specs(node_name='inverse_dynamics_node', path=None):
     """Return the parameters of ``node_name`` as a list of ParameterSpec."""
+    path = path or schema_path(node_name)
     with open(path, encoding='utf-8') as fh:
         schema = yaml.safe_load(fh)
-    return list(_flatten(schema[node_name]))
+    return list(_flatten(schema[node_name], path))
 
 
 def validate(values, specs):
@@ -146,8 +159,9 @@ def markdown_table(specs):
 
 
 if __name__ == '__main__':
-    if sys.argv[1:] != ['--markdown']:
-        print('usage: python -m newton_euler_ros.parameters --markdown',
-              file=sys.stderr)
+    if sys.argv[1:2] != ['--markdown'] or len(sys.argv) > 3 or \
+            sys.argv[2:] and sys.argv[2] not in NODES:
+        print('usage: python -m newton_euler_ros.parameters --markdown '
+              f'[{"|".join(NODES)}]', file=sys.stderr)
         sys.exit(2)
-    print(markdown_table(load_specs()))
+    print(markdown_table(load_specs(*sys.argv[2:])))

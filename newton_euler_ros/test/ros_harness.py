@@ -23,7 +23,7 @@ import os
 import sys
 import time
 
-from newton_euler_ros.processes import ChildProcess, ros_env  # noqa: F401
+from newton_euler_tools.processes import ChildProcess, ros_env  # noqa: F401
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PARAMS_DIR = os.path.join(PACKAGE_DIR, 'config', 'params')

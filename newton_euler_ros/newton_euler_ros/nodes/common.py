@@ -13,19 +13,29 @@
 # limitations under the License.
 
 """
-What every node of the package shares: QoS from parameters, and main().
+What every node of the package shares: parameters, QoS, and main().
+
+``declare_parameters`` declares a node's parameters from its schema
+(:mod:`..parameters`: ``<node>_parameters.yaml``) with their
+descriptions and read-only flags, and validates them: a wrong type or an
+invalid value is a :class:`ConfigurationError` (one line, exit status 2).
 
 ``run_node`` is the Jazzy-style main: init, build the node (a
 configuration error refuses to start with a one-line reason and exit
 status 2), spin until SIGINT/SIGTERM or shutdown, destroy, shut down;
 a stop is exit status 0, also during start-up (one line).
 
-Spinning uses rclpy's EventsExecutor through ``spin_once`` when it is
-available: measured with ``make latency``, it halves the node's CPU use
-and lowers the p99 input-to-torque latency.  Its ``spin()`` is avoided
-(in this rclpy build it busy-waits and ignores shutdown).  Set
-``NEWTON_EULER_EXECUTOR=single_threaded`` to use the classic executor.
+Spinning uses rclpy's SingleThreadedExecutor through ``spin_once``:
+its memory stays bounded by the subscriptions' QoS depth under any flood
+of messages.  ``NEWTON_EULER_EXECUTOR=events`` chooses the experimental
+EventsExecutor instead: ``make latency`` measures both side by side (it
+uses about half the CPU and has a lower p99), but it queues one handler
+per message it has not yet run, so a flood faster than the node's
+callbacks grows its memory without bound until the flood stops.  The
+EventsExecutor's ``spin()`` is avoided (in this rclpy build it busy-waits
+and ignores shutdown).
 """
+import array
 import os
 import signal
 import sys
@@ -35,8 +45,18 @@ import rclpy
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, \
     SingleThreadedExecutor
+from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
+
+from ..parameters import validate
+
+_PARAM_TYPES = {
+    'string': Parameter.Type.STRING, 'double': Parameter.Type.DOUBLE,
+    'int': Parameter.Type.INTEGER, 'bool': Parameter.Type.BOOL,
+    'string_array': Parameter.Type.STRING_ARRAY,
+    'double_array': Parameter.Type.DOUBLE_ARRAY,
+}
 
 
 class ConfigurationError(Exception):
@@ -71,10 +91,51 @@ def declare_parameter(node, name, default, descriptor):
             f'{hint}') from None
 
 
-def declare(node, name, default, description):
-    """Declare a parameter with a description; return its value."""
-    return declare_parameter(node, name, default, ParameterDescriptor(
-        description=description)).value
+def plain(value):
+    """Return a parameter value with arrays (tuple, array.array) as lists."""
+    if isinstance(value, (tuple, list, array.array)):
+        return list(value)
+    return value
+
+
+def declare_parameters(node, specs):
+    """
+    Declare every parameter of ``specs`` on ``node``; return their values.
+
+    ``specs`` is a list of :class:`..parameters.ParameterSpec`.  Each gets
+    its description and read-only flag; the values (defaults or
+    overrides, arrays as lists) are validated against the schema's rules.
+    A wrong type or an invalid value raises ConfigurationError.
+    """
+    values = {}
+    for spec in specs:
+        desc = ParameterDescriptor(description=spec.description,
+                                   read_only=spec.read_only)
+        if spec.default == [] or spec.default == '':
+            # an empty default does not tell rclpy the type
+            declare_parameter(node, spec.name, _PARAM_TYPES[spec.type], desc)
+            param = node.get_parameter_or(spec.name, None)
+            value = param.value if param is not None else None
+            values[spec.name] = spec.default if value is None else value
+        else:
+            values[spec.name] = declare_parameter(
+                node, spec.name, spec.default, desc).value
+        values[spec.name] = plain(values[spec.name])
+    errors = validate(values, specs)
+    if errors:
+        raise ConfigurationError('; '.join(errors))
+    return values
+
+
+def check_parameters(params, specs):
+    """
+    Validate parameters set at run time: (values, reasons).
+
+    ``values`` maps each name to its plain value; ``reasons`` is '' when
+    every value passes the schema's rules, else why not (one line).
+    """
+    values = {param.name: plain(param.value) for param in params}
+    return values, '; '.join(validate(values, specs))
 
 
 def _libc_trim():
@@ -92,24 +153,41 @@ def release_memory():
     """
     Give freed heap back to the operating system (glibc ``malloc_trim``).
 
-    Under a flood of messages the EventsExecutor queues one small handler
-    per message it has not yet run; once the flood is over they are freed,
-    but glibc keeps the pages, so the process' RSS would stay at its peak.
+    Under a flood of messages the EventsExecutor (when chosen) queues one
+    small handler per message it has not yet run; once the flood is over
+    they are freed, but glibc keeps the pages, so the process' RSS would
+    stay at its peak.
     Nodes call this from their periodic timer: about 0.1 ms.
     """
     if _MALLOC_TRIM is not None:
         _MALLOC_TRIM(0)
 
 
-def make_executor():
-    """Return the executor to spin with (EventsExecutor when available)."""
-    if os.environ.get('NEWTON_EULER_EXECUTOR') != 'single_threaded':
+EXECUTORS = ('single_threaded', 'events')
+
+
+def make_executor(kind=None, context=None):
+    """
+    Return the executor ``kind`` names, for ``context`` (None: default).
+
+    ``kind`` is 'single_threaded' or 'events'; None reads
+    ``NEWTON_EULER_EXECUTOR`` (default single_threaded).  Without an
+    EventsExecutor in this rclpy, 'events' gives the single-threaded one;
+    ``type(executor).__name__`` says which.
+    """
+    if kind is None:
+        kind = os.environ.get('NEWTON_EULER_EXECUTOR') or 'single_threaded'
+    if kind not in EXECUTORS:
+        raise ConfigurationError(
+            f'NEWTON_EULER_EXECUTOR must be one of {", ".join(EXECUTORS)}, '
+            f'got {kind[:80]!r}')
+    if kind == 'events':
         try:
             from rclpy.experimental import EventsExecutor
-            return EventsExecutor()
+            return EventsExecutor(context=context)
         except ImportError:
             pass
-    return SingleThreadedExecutor()
+    return SingleThreadedExecutor(context=context)
 
 
 def run_node(make_node, name, args=None):
@@ -131,18 +209,18 @@ def run_node(make_node, name, args=None):
     node = None
     code = 0
     try:
+        executor = make_executor()
         if not stop:
             node = make_node()
         if stop:
             print(f'{name}: stopped during start-up '
                   f'({signal.Signals(stop[0]).name})', file=sys.stderr)
             return 0
-        executor = make_executor()
         executor.add_node(node)
         while rclpy.ok() and not stop:
             executor.spin_once(timeout_sec=0.1)
     except ConfigurationError as exc:
-        print(f'{name}: invalid parameters: {exc}', file=sys.stderr)
+        print(f'{name}: invalid configuration: {exc}', file=sys.stderr)
         code = 2
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

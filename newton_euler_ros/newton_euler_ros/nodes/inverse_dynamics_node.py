@@ -33,7 +33,6 @@ Publishes
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
-import array
 import dataclasses
 import sys
 import threading
@@ -43,16 +42,16 @@ from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
 import numpy as np
-from rcl_interfaces.msg import ParameterDescriptor, SetParametersResult
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
-from .common import (ConfigurationError, declare_parameter, qos_profile,
-                     release_memory, run_node)
+from .common import (check_parameters, ConfigurationError,
+                     declare_parameters, plain, qos_profile, release_memory,
+                     run_node)
 from ..core import inspect_robot, NewtonEulerError
 from ..core.scene import load_scene
 from ..core.trajectory import trajectory_efforts
@@ -60,16 +59,10 @@ from ..core.urdf import urdf_model
 from ..feedforward import (check_payload, clip, FeedforwardComputer,
                            InputRejected, JointOrder, payload_model,
                            ReferenceTrajectory, rigid_frames, WrenchInput)
-from ..parameters import load_specs, validate
+from ..parameters import load_specs
 from ..safety import (effort_bounds, TorqueGuard, velocity_bounds,
                       wrench_bounds)
 
-_PARAM_TYPES = {
-    'string': Parameter.Type.STRING, 'double': Parameter.Type.DOUBLE,
-    'int': Parameter.Type.INTEGER, 'bool': Parameter.Type.BOOL,
-    'string_array': Parameter.Type.STRING_ARRAY,
-    'double_array': Parameter.Type.DOUBLE_ARRAY,
-}
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
             'service_calls', 'service_failures', 'internal_error',
@@ -92,7 +85,7 @@ class InverseDynamicsNode(Node):
     def __init__(self, **kwargs):
         super().__init__('inverse_dynamics_node', **kwargs)
         self.specs = load_specs()
-        p = self.params = self._declare_parameters()
+        p = self.params = declare_parameters(self, self.specs)
         self.counts = dict.fromkeys(COUNTERS, 0)
         self.log_throttle = p['log_throttle']
         self._last_log = {}
@@ -278,27 +271,6 @@ class InverseDynamicsNode(Node):
         self._log_model(ff, self.model_source)
 
     # ---- parameters ----
-    def _declare_parameters(self):
-        values = {}
-        for spec in self.specs:
-            desc = ParameterDescriptor(description=spec.description,
-                                       read_only=spec.read_only)
-            if spec.default == [] or spec.default == '':
-                # an empty default does not tell rclpy the type
-                declare_parameter(self, spec.name,
-                                  _PARAM_TYPES[spec.type], desc)
-                param = self.get_parameter_or(spec.name, None)
-                value = param.value if param is not None else None
-                values[spec.name] = spec.default if value is None else value
-            else:
-                values[spec.name] = declare_parameter(
-                    self, spec.name, spec.default, desc).value
-            values[spec.name] = _plain(values[spec.name])
-        errors = validate(values, self.specs)
-        if errors:
-            raise ConfigurationError('; '.join(errors))
-        return values
-
     def _wrench_input(self, p, model, bounds):
         return WrenchInput(p['wrench.base_frames'],
                            p['wrench.end_effector_frames'],
@@ -306,15 +278,13 @@ class InverseDynamicsNode(Node):
                            rigid_frames(model), wrench_bounds(bounds))
 
     def _on_set_parameters(self, params):
-        values = {param.name: _plain(param.value) for param in params}
-        errors = validate(values, self.specs)
+        values, errors = check_parameters(params, self.specs)
         if errors:
-            return SetParametersResult(successful=False,
-                                       reason='; '.join(errors))
+            return SetParametersResult(successful=False, reason=errors)
         current = {s.name: values.get(s.name,
                                       self.get_parameter(s.name).value)
                    for s in self.specs if s.name.startswith('wrench.')}
-        current = {k: _plain(v) for k, v in current.items()}
+        current = {k: plain(v) for k, v in current.items()}
         payload = tuple(values.get(k, self.params[k]) for k in (
             'payload.mass', 'payload.com', 'payload.inertia'))
         ff = self.ff
@@ -379,10 +349,12 @@ class InverseDynamicsNode(Node):
             self._no_model('joint state')
             return
         try:
-            expired = ff.wrench.expired
+            now = self._now()
             tau = ff.torques(msg.name, msg.position, msg.velocity,
-                             _seconds(msg.header.stamp), self._now())
-            if ff.wrench.expired != expired:
+                             _seconds(msg.header.stamp), now)
+            # the torques left the wrench out once it was too old: say so
+            # once, with the first state answered without it
+            if ff.wrench.expire(now):
                 self._reject('wrench', InputRejected(
                     'expired', 'the last wrench is older than '
                     f'{ff.wrench.timeout} s; torques no longer include '
@@ -555,13 +527,6 @@ class InverseDynamicsNode(Node):
         msg = DiagnosticArray(status=[status, model])
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
-
-
-def _plain(value):
-    """Return a parameter value with arrays (tuple, array.array) as lists."""
-    if isinstance(value, (tuple, list, array.array)):
-        return list(value)
-    return value
 
 
 def _clip(text, limit=400):

@@ -21,16 +21,19 @@ scene's integrator step, holding the last torque command (zero-order
 hold), then publishes the state.  Simulated time t maps onto the
 wall-clock stamp ``start + t``; ``~/start`` (latched) carries ``start``
 so that controllers can align their reference.  Once a publisher on
-``~/commands`` or ``~/joint_trajectory`` exists (``wait_for_controller``)
-and joint_states has
-``wait_for_subscribers`` matched subscribers, ``start`` is announced
-LEAD seconds ahead, so that the controller and the inverse-dynamics node
-have the reference (and the wrench) before t = 0; and t = 0 is held
-until the first command arrives (at most FIRST_COMMAND seconds: the
+``~/commands`` or ``~/joint_trajectory`` is matched
+(``wait_for_controller``) and joint_states has ``wait_for_subscribers``
+matched subscribers (tracking_controller_node subscribes only once its
+own peers are matched: then every node has discovered its peers), and
+GRACE seconds later, ``start`` is announced LEAD seconds ahead, so
+that the controller and the inverse-dynamics node have the reference
+(and the wrench) before t = 0; and t = 0 is held until the first
+command arrives (at most FIRST_COMMAND seconds: the
 first message over a fresh connection is slow), so the robot does not
 start with a period at zero torque.  Stamps then run that much behind the
 wall clock.  The simulation stops advancing after the scene's duration,
-still publishing.
+still publishing.  Parameters: ``robot_sim_parameters.yaml``.  On exit
+the node logs how many commands it received (``commands received: N``).
 
 A stand-in for joint_trajectory_controller with an effort command
 interface: a ``JointTrajectory`` on ``~/joint_trajectory`` (stamped on
@@ -48,7 +51,6 @@ Publishes
     wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),
     ~/start (std_msgs/Header, transient local)
 """
-import array
 import dataclasses
 import math
 import sys
@@ -64,12 +66,14 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory
 
-from .common import ConfigurationError, declare, qos_profile, run_node
+from .common import (check_parameters, ConfigurationError,
+                     declare_parameters, qos_profile, run_node)
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
 from ..core.simulate import integrator_step, SceneDynamics
 from ..core.trajectory import TrajectoryFollower
 from ..feedforward import payload_model
+from ..parameters import load_specs
 from ..safety import effort_bounds, TorqueGuard
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
@@ -101,36 +105,18 @@ class RobotSimNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('robot_sim_node', **kwargs)
-        name = declare(self, 'scene', '',
-                       'Scene YAML file or bundled scene name to simulate.')
-        rtf = declare(self, 'real_time_factor', 1.0,
-                      'Simulated seconds per wall-clock second (> 0).')
-        self.wait = declare(self, 'wait_for_controller', True,
-                            'Hold t = 0 until a publisher on ~/commands '
-                            'exists.')
-        self.subscribers = declare(self, 'wait_for_subscribers', 0,
-                                   'Hold t = 0 until joint_states has this '
-                                   'many matched subscribers.')
-        if not name:
-            raise ConfigurationError('scene: must not be empty')
-        if not rtf > 0.0:
-            raise ConfigurationError(f'real_time_factor: must be > 0, got '
-                                     f'{rtf}')
+        self.specs = load_specs('robot_sim_node')
+        p = declare_parameters(self, self.specs)
+        self.wait = p['wait_for_controller']
+        self.subscribers = p['wait_for_subscribers']
+        rtf = p['real_time_factor']
         try:
-            self.scene = load_scene(name)
+            self.scene = load_scene(p['scene'])
         except NewtonEulerError as exc:
             raise ConfigurationError(f'scene: {exc}') from None
         scene = self.scene
-        self.dyn = SceneDynamics(scene)
-        self.payload = (
-            declare(self, 'payload.mass', 0.0, 'Payload the plant picks up '
-                    '(kg), fixed to the end effector; settable at run '
-                    'time.'),
-            declare(self, 'payload.com', [0.0, 0.0, 0.0], 'Its centre of '
-                    'mass in the end-effector frame (m).'),
-            declare(self, 'payload.inertia', [0.0] * 6, 'Its inertia about '
-                    'the centre of mass, [Ixx, Iyy, Izz, Ixy, Iyz, Ixz] in '
-                    'end-effector axes (kg m^2).'))
+        self.payload = (p['payload.mass'], p['payload.com'],
+                        p['payload.inertia'])
         try:
             self.dyn = self._plant(self.payload)
         except ValueError as exc:
@@ -140,14 +126,8 @@ class RobotSimNode(Node):
         self.over_limit = 0          # commands beyond the torque bounds
         # the same torque guard as inverse_dynamics_node: the robot's
         # effort limits, else bounds derived from it
-        try:
-            self.guard = TorqueGuard(
-                effort_bounds(scene.model)[0],
-                declare(self, 'limits.action', 'clamp', 'What a commanded '
-                        'torque above its bound does: clamp, drop (keep the '
-                        'previous command) or publish (apply it anyway).'))
-        except ValueError as exc:
-            raise ConfigurationError(str(exc)) from None
+        self.guard = TorqueGuard(effort_bounds(scene.model)[0],
+                                 p['limits.action'])
         n = scene.model.n
         self.q = scene.q0.astype(float).copy()
         self.qd = scene.qd0.astype(float).copy()
@@ -183,10 +163,10 @@ class RobotSimNode(Node):
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.start_pub = self.create_publisher(Header, '~/start', latched)
-        self.create_subscription(Float64MultiArray, '~/commands',
-                                 self._on_command, qos)
-        self.create_subscription(JointTrajectory, '~/joint_trajectory',
-                                 self._on_trajectory, 10)
+        self.cmd_sub = self.create_subscription(
+            Float64MultiArray, '~/commands', self._on_command, qos)
+        self.traj_sub = self.create_subscription(
+            JointTrajectory, '~/joint_trajectory', self._on_trajectory, 10)
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self._state = JointState()
         self._state.name = list(scene.model.joint_names)
@@ -224,10 +204,10 @@ class RobotSimNode(Node):
     def _ready(self):
         if not self.wait:
             return True
-        controllers = (
-            self.count_publishers(self.resolve_topic_name('~/commands'))
-            + self.count_publishers(
-                self.resolve_topic_name('~/joint_trajectory')))
+        # matched publishers (this node's readers know them), not just
+        # discovered ones
+        controllers = (self.cmd_sub.get_publisher_count()
+                       + self.traj_sub.get_publisher_count())
         if (controllers < 1
                 or self.state_pub.get_subscription_count()
                 < self.subscribers):
@@ -308,9 +288,9 @@ class RobotSimNode(Node):
         return SceneDynamics(dataclasses.replace(self.scene, model=model))
 
     def _on_set_parameters(self, params):
-        values = {p.name: (list(p.value) if isinstance(
-            p.value, (tuple, list, array.array)) else p.value)
-            for p in params}
+        values, errors = check_parameters(params, self.specs)
+        if errors:
+            return SetParametersResult(successful=False, reason=errors)
         keys = ('payload.mass', 'payload.com', 'payload.inertia')
         if not any(k in values for k in keys):
             return SetParametersResult(successful=True)
@@ -390,6 +370,14 @@ class RobotSimNode(Node):
         f, tq = m.wrench.force, m.wrench.torque
         f.x, f.y, f.z, tq.x, tq.y, tq.z = (float(x) for x in w)
         self.wrench_pub.publish(m)
+
+    def destroy_node(self):
+        """Log how many commands the plant received, then destroy."""
+        self.get_logger().info(
+            f'commands received: {self.commands} ({self.dropped} malformed '
+            f'messages dropped, {self.over_limit} commands over the torque '
+            f'bounds)')
+        return super().destroy_node()
 
 
 def main(args=None):

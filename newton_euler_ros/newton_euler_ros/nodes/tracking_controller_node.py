@@ -15,23 +15,29 @@
 """
 tracking_controller_node: PD on a scene's reference plus feedforward.
 
-Once the simulator's start time t0 is known (latched ``/robot_sim_node/
-start``), the node publishes the scene's reference on ``reference``
-(remap it to ``/inverse_dynamics_node/reference``) and, for every joint
-state, commands
+Once the simulator's start time t0 is known (latched ``~/start``, remapped
+to ``/robot_sim_node/start``), the node publishes the scene's reference on
+``~/reference`` (remap it to ``/inverse_dynamics_node/reference``) and,
+for every joint state, commands
 
     tau = kp (q_d - q) + kd (qd_d - qd) + ff
 
-with (q_d, qd_d) the reference at t = stamp - t0 and ff the inverse-
-dynamics node's torques for the same stamp (the node waits for them).
-With ``feedforward`` false, ff = 0 and every state is answered at once.
+on ``~/commands`` (remap it to ``/robot_sim_node/commands``), with
+(q_d, qd_d) the reference at t = stamp - t0 and ff the inverse-dynamics
+node's torques for the same stamp, read from ``~/feedforward`` (remap it
+to ``/inverse_dynamics_node/torques``; the node waits for them).  With
+``feedforward`` false, ff = 0 and every state is answered at once.
+``joint_states`` is subscribed only once the peers are matched
+(``wait_for_subscribers``).  The remaps of the closed loop are
+:data:`..graph.CONTROLLER_REMAPS` (used by launch/closed_loop.launch.py
+and the demo).
 
 Subscribes
-    joint_states (sensor_msgs/JointState), /robot_sim_node/start
-    (std_msgs/Header, transient local), feedforward_topic
-    (sensor_msgs/JointState, only with feedforward)
+    joint_states (sensor_msgs/JointState), ~/start (std_msgs/Header,
+    transient local), ~/feedforward (sensor_msgs/JointState, only with
+    feedforward)
 Publishes
-    commands (std_msgs/Float64MultiArray), reference
+    ~/commands (std_msgs/Float64MultiArray), ~/reference
     (trajectory_msgs/JointTrajectory)
 """
 from collections import OrderedDict
@@ -45,9 +51,12 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from .common import ConfigurationError, declare, qos_profile, run_node
+from .common import (ConfigurationError, declare_parameters, qos_profile,
+                     run_node)
 from ..core import NewtonEulerError
 from ..core.scene import load_scene
+from ..core.simulate import pd_torque
+from ..parameters import load_specs
 
 SAMPLE = 0.01           # reference sampling period, seconds
 PENDING = 32            # joint states / feedforward kept for matching
@@ -86,20 +95,13 @@ class TrackingControllerNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('tracking_controller_node', **kwargs)
-        name = declare(self, 'scene', '',
-                       'Scene YAML file or bundled scene name: reference, '
-                       'gains.')
-        self.use_ff = declare(self, 'feedforward', True,
-                              'Add the inverse-dynamics torques for the '
-                              'same stamp (false: PD alone).')
-        ff_topic = declare(self, 'feedforward_topic',
-                           '/inverse_dynamics_node/torques',
-                           'sensor_msgs/JointState topic of the '
-                           'feedforward torques.')
-        if not name:
-            raise ConfigurationError('scene: must not be empty')
+        self.specs = load_specs('tracking_controller_node')
+        p = declare_parameters(self, self.specs)
+        self.use_ff = p['feedforward']
+        self.wait_subscribers = p['wait_for_subscribers']
+        self.qos = qos_profile(10, 'reliable')
         try:
-            self.scene = load_scene(name)
+            self.scene = load_scene(p['scene'])
         except NewtonEulerError as exc:
             raise ConfigurationError(f'scene: {exc}') from None
         self.names = list(self.scene.model.joint_names)
@@ -113,26 +115,48 @@ class TrackingControllerNode(Node):
         self._ref_msg = None
         self._ref_count = 0
 
-        qos = qos_profile(10, 'reliable')
+        # deep history on the commands: a slow reader (a Python recorder)
+        # loses none of them (as robot_sim_node's joint_states)
+        self.cmd_pub = self.create_publisher(Float64MultiArray, '~/commands',
+                                             qos_profile(100, 'reliable'))
+        self.ref_pub = self.create_publisher(JointTrajectory, '~/reference',
+                                             10)
         latched = QoSProfile(depth=1,
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.cmd_pub = self.create_publisher(Float64MultiArray, 'commands',
-                                             qos)
-        self.ref_pub = self.create_publisher(JointTrajectory, 'reference',
-                                             10)
-        self.create_subscription(Header, '/robot_sim_node/start',
-                                 self._on_start, latched)
-        self.create_subscription(JointState, 'joint_states', self._on_state,
-                                 qos)
-        if self.use_ff:
-            self.create_subscription(JointState, ff_topic, self._on_ff, qos)
-        self.create_timer(REPUBLISH, self._publish_reference)
+        self.create_subscription(Header, '~/start', self._on_start, latched)
+        self.ff_sub = (self.create_subscription(
+            JointState, '~/feedforward', self._on_ff, self.qos)
+            if self.use_ff else None)
+        self.state_sub = None       # once the peers are matched
+        self.create_timer(REPUBLISH, self._on_timer)
         self._cmd = Float64MultiArray()
         self.get_logger().info(
             f'{self.scene.name}: PD on {self.n} joints'
-            + (f' + feedforward from {ff_topic}' if self.use_ff else
-               ' alone (no feedforward)'))
+            + (' + feedforward from '
+               f'{self.resolve_topic_name("~/feedforward")}'
+               if self.use_ff else ' alone (no feedforward)')
+            + f', commands on {self.resolve_topic_name("~/commands")}')
+        self._on_timer()
+
+    def _peers_matched(self):
+        """Return True once the outputs and the feedforward are matched."""
+        if self.cmd_pub.get_subscription_count() < self.wait_subscribers:
+            return False
+        return not self.use_ff or self.wait_subscribers == 0 or (
+            self.ff_sub.get_publisher_count() >= 1
+            and self.ref_pub.get_subscription_count() >= 1)
+
+    def _on_timer(self):
+        if self.state_sub is None and self._peers_matched():
+            # subscribing last tells a simulator that waits for
+            # joint_states subscribers that this node can be heard
+            self.state_sub = self.create_subscription(
+                JointState, 'joint_states', self._on_state, self.qos)
+            self.get_logger().info(
+                f'peers matched ({self.cmd_pub.get_subscription_count()} '
+                'command subscribers); subscribed to joint_states')
+        self._publish_reference()
 
     def _gather(self, names, values, what):
         """Return ``values`` in the model's joint order."""
@@ -221,7 +245,7 @@ class TrackingControllerNode(Node):
 
     def _command(self, t, q, qd, ff):
         q_d, qd_d, _ = self.scene.reference.at(t)
-        tau = self.scene.kp * (q_d - q) + self.scene.kd * (qd_d - qd) + ff
+        tau = pd_torque(self.scene, q_d, qd_d, q, qd) + ff
         if not np.isfinite(tau).all():
             self.get_logger().warning('non-finite torque; not sent',
                                       throttle_duration_sec=2.0)
@@ -234,6 +258,11 @@ class TrackingControllerNode(Node):
                 raise
             return      # shutting down (SIGINT): the context is closed
         self.published += 1
+
+    def destroy_node(self):
+        """Log how many commands were sent, then destroy the node."""
+        self.get_logger().info(f'commands sent: {self.published}')
+        return super().destroy_node()
 
 
 def main(args=None):

@@ -83,7 +83,11 @@ def test_wrench_sign_frames_and_staleness():
     assert frame == 'end_effector' and wrench.tolist() == [-1, -2, -3, -4,
                                                            -5, -6]
     assert w.current(now=10.6) == (None, 'end_effector')   # expired
+    assert w.expired == 0 and w.current(now=10.2)[0] is not None  # a read
+    assert w.expire(now=10.2) is False and w.expire(now=10.6) is True
     assert w.expired == 1
+    assert w.expire(now=10.7) is False and w.expired == 1   # counted once
+    assert w.current(now=10.2) == (None, 'end_effector')    # dropped
     with pytest.raises(InputRejected, match='is not one of') as info:
         w.update('camera', [0] * 6, 10.0, 10.0)
     assert info.value.kind == 'unknown_frame'

@@ -144,8 +144,8 @@ def test_bad_states_file(tmp_path):
 
 def test_package_imports_from_the_repository_root():
     """The newton_euler_ros/ folder must not shadow the installed package."""
-    root = os.path.dirname(os.path.dirname(os.path.dirname(
-        os.path.abspath(__file__))))
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__)))))
     proc = subprocess.run(
         [sys.executable, '-c', 'import newton_euler_ros as p; '
                                'print(p.__file__, p.__version__)'],
@@ -214,7 +214,7 @@ def test_exit_statuses(tmp_path):
 def test_check_warns_when_the_mass_matrix_is_singular(tmp_path):
     import yaml
     data = yaml.safe_load(open(os.path.join(
-        os.path.dirname(__file__), '..', 'config', 'robots',
+        os.path.dirname(__file__), '..', '..', 'config', 'robots',
         'planar_2r.yaml')))
     data['links'][-1].update(mass=0.0, com=[0, 0, 0],
                              inertia=[0, 0, 0, 0, 0, 0])

@@ -15,7 +15,7 @@
 """Scenes and simulation: only the effects a scene calls for, by physics."""
 import copy
 
-from newton_euler_ros.core import _kernels as K
+from newton_euler_ros.core import _kernels as K, dynamics
 from newton_euler_ros.core import (gravity_torques, inverse_dynamics,
                                    load_robot, RobotFileError)
 from newton_euler_ros.core.model import with_payload
@@ -53,12 +53,12 @@ def test_zero_gravity_never_evaluates_gravity(monkeypatch):
     dyn = SceneDynamics(scene)
     q = np.array([0.1, 0.7, -0.3, 0.2, 0.4, 0.1])
     seen = []
-    real = K.inverse_dynamics
+    real = dynamics._tau              # the Newton-Euler entry point
 
     def spy(*args):
-        seen.append(args[6])           # the gravity_on flag
+        seen.append(bool(args[5] & K.GRAVITY))    # the gravity flag
         return real(*args)
-    monkeypatch.setattr(K, 'inverse_dynamics', spy)
+    monkeypatch.setattr(dynamics, '_tau', spy)
     tau = dyn.torques(q, np.zeros(6), np.zeros(6), 0.0)
     assert seen == [False]
     assert np.all(tau == 0.0)         # exactly zero, not round-off
@@ -254,14 +254,6 @@ def test_numbers_as_strings_are_coerced():
     assert scene_from_dict(data, 's.yaml', folder).step == 1e-3
 
 
-def test_effect_benchmark_runs(capsys):
-    """Smoke test: the effect benchmark runs (its figures are not judged)."""
-    from newton_euler_ros import bench_effects
-    assert bench_effects.main(['puma_payload_press', '--quick']) == 0
-    out = capsys.readouterr().out
-    assert 'without friction' in out and 'none (D qdd only)' in out
-
-
 def test_live_wrench_equals_constant_wrench():
     """A topic-fed wrench, once set, acts exactly like a constant one."""
     data, folder = bundled('puma_payload_press')
@@ -294,7 +286,7 @@ def test_scene_controller_is_stable_sampled_at_its_rate(name):
     """
     import dataclasses
 
-    from newton_euler_ros.accuracy.scenes import held_controller
+    from newton_euler_tools.accuracy.scenes import held_controller
     from newton_euler_ros.core.simulate import simulate
     scene = load_scene(name)
     for gain in (1.0, 1.5):

@@ -12,13 +12,18 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ament_flake8 (the ROS 2 flake8 configuration) over the whole package."""
+"""ament_flake8 (the ROS 2 flake8 configuration) over the package + tools/."""
 import os
 
 from ament_flake8.main import main_with_errors
 import pytest
 
-PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__))))
+# the tools beside the package (tools/ of the repository), when present
+TOOLS = os.path.join(os.pardir, 'tools')
+PATHS = ['.'] + ([TOOLS] if os.path.isdir(os.path.join(PACKAGE_DIR, TOOLS))
+                 else [])
 
 
 @pytest.mark.flake8
@@ -27,7 +32,7 @@ def test_flake8(monkeypatch):
     # ament_flake8 lints the current directory; `make test` runs pytest from
     # the repository root, so lint from the package directory instead.
     monkeypatch.chdir(PACKAGE_DIR)
-    rc, errors = main_with_errors(argv=[])
+    rc, errors = main_with_errors(argv=PATHS)
     assert rc == 0, \
         'Found %d code style errors / warnings:\n' % len(errors) + \
         '\n'.join(errors)

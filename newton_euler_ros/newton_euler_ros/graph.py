@@ -1,0 +1,40 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The closed loop's wiring, without ROS: one place for its remaps.
+
+The nodes use relative (``joint_states``, ``wrench``) or private
+(``~/commands``) names; a graph connects them by remapping.  The closed
+loop of the demo is robot_sim_node -> inverse_dynamics_node ->
+tracking_controller_node -> robot_sim_node, with the nodes' default
+names; ``launch/closed_loop.launch.py`` and ``newton_euler_tools.demo``
+both take its remaps from here.
+"""
+SIM = '/robot_sim_node'
+ID = '/inverse_dynamics_node'
+
+#: (from, to) remaps of tracking_controller_node in the closed loop
+CONTROLLER_REMAPS = (
+    ('~/start', f'{SIM}/start'),
+    ('~/feedforward', f'{ID}/torques'),
+    ('~/reference', f'{ID}/reference'),
+    ('~/commands', f'{SIM}/commands'),
+)
+
+
+def ros_args(remaps):
+    """Return ``remaps`` as command-line arguments: ['-r', 'a:=b', ...]."""
+    return [arg for name, target in remaps
+            for arg in ('-r', f'{name}:={target}')]
