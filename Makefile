@@ -1,6 +1,7 @@
 # newton_euler_ros: one-command set-up, tests, demo and benchmark.
 #   make setup   create/refresh .venv (idempotent; < 2 s when up to date)
 #   make test    set up if needed, then run pytest over newton_euler_ros/test
+#                and tools/test (pytest.ini)
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
@@ -36,26 +37,27 @@ test: setup
 	$(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
 
 demo: setup
-	$(PY) -m newton_euler_ros.demo
+	$(PY) -m newton_euler_tools.demo
 
 demo-pick: setup
-	$(PY) -m newton_euler_ros.demo_pick
+	$(PY) -m newton_euler_tools.demo_pick
 
 bench: setup
-	$(PY) -m newton_euler_ros.bench
-	$(PY) -m newton_euler_ros.bench_effects
-	$(PY) -m newton_euler_ros.bench_urdf
-	$(PY) -m newton_euler_ros.bench_trajectory
+	$(PY) -m newton_euler_tools.bench
+	$(PY) -m newton_euler_tools.bench_effects
+	$(PY) -m newton_euler_tools.bench_urdf
+	$(PY) -m newton_euler_tools.bench_trajectory
+	$(PY) -m newton_euler_tools.bench_scaling
 
 latency: setup
-	$(PY) -m newton_euler_ros.latency_bench
+	$(PY) -m newton_euler_tools.latency_bench
 
 # The full report compares with the peers, so it installs them first.
 accuracy: peers
-	$(PY) -m newton_euler_ros.accuracy --out docs
+	$(PY) -m newton_euler_tools.accuracy --out docs
 
 accuracy-quick: setup
-	$(PY) -m newton_euler_ros.accuracy --quick --out build/accuracy-quick
+	$(PY) -m newton_euler_tools.accuracy --quick --out build/accuracy-quick
 
 # Constrained by the main lock so the peers cannot move numpy & co.
 peers: setup
@@ -66,4 +68,4 @@ colcon-check: setup
 	bash scripts/colcon_check.sh
 
 clean:
-	rm -rf build $(VENV) newton_euler_ros/*.egg-info
+	rm -rf build $(VENV) newton_euler_ros/*.egg-info tools/*.egg-info

@@ -40,6 +40,22 @@ unset PYTHONPATH COLCON_PREFIX_PATH
 export ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST
 export ROS_LOG_DIR="$ROOT/build/ros_log"
 
+# The repository as a user's src/ would hold it: colcon must find the two
+# packages and nothing else.  tools/ holds the benchmarks, the report and
+# the demos, not robot code; tools/COLCON_IGNORE keeps it out (the colcon
+# pinned here does not list a pyproject.toml-only package; other colcon
+# extensions may).
+[[ -f "$ROOT/tools/COLCON_IGNORE" ]] || die "tools/COLCON_IGNORE missing"
+bases=()
+for d in "$ROOT"/*/; do
+  case "$(basename "$d")" in build|install|log|out) continue ;; esac
+  bases+=("$d")
+done
+found="$(colcon --log-base /dev/null list --names-only --base-paths "${bases[@]}" | sort | xargs)"
+[[ "$found" == "newton_euler_interfaces newton_euler_ros" ]] \
+  || die "colcon finds '$found' in the repository, expected the two packages (tools/COLCON_IGNORE?)"
+log "colcon finds in the repository: $found (tools/ ignored)"
+
 cd "$WS"
 cmd=(colcon build "$@" --event-handlers console_cohesion+
      --cmake-args -DBUILD_TESTING=OFF -DPython3_EXECUTABLE="$VENV/bin/python")
@@ -71,6 +87,10 @@ for what, path in [('newton_euler_interfaces', newton_euler_interfaces.__file__)
     assert os.path.realpath(path).startswith(os.path.dirname(install)), \
         f'{what} not taken from the workspace'
 assert os.path.isdir(os.path.join(share, 'config', 'robots'))
+# What runs on a robot only: the tools are not part of the package.
+import importlib.util
+assert importlib.util.find_spec('newton_euler_ros.bench') is None
+assert importlib.util.find_spec('newton_euler_ros.accuracy') is None
 # Non-Python files that modules read from beside themselves must be installed.
 import glob
 src = os.path.join(os.path.dirname(install), 'src', 'newton_euler_ros', 'newton_euler_ros')

@@ -8,6 +8,8 @@
 #   3. package      `pip install -e` newton_euler_ros (edits take effect
 #                   without reinstalling) and copy its data files
 #                   (config/, launch/, package.xml) to .venv/share/newton_euler_ros
+#   4. tools        `pip install -e` tools/ (newton_euler_tools: benchmarks,
+#                   accuracy report, demos; not part of the ROS package)
 #
 # Each step is skipped when a hash of its inputs matches the stamp it wrote
 # the last time it succeeded.  Stamps live inside .venv/.setup-stamps, so
@@ -31,6 +33,7 @@ REQ="$ROOT/requirements"
 IFACE_SRC="$ROOT/newton_euler_interfaces"
 IFACE_BUILD="$BUILD/newton_euler_interfaces"
 PKG_SRC="$ROOT/newton_euler_ros"
+TOOLS_SRC="$ROOT/tools"
 PY_MINOR="3.11"
 PY_TUPLE="3, 11"   # same version, as a Python tuple
 WHEELHOUSE_ROOT="${WHEELHOUSE:-${XDG_CACHE_HOME:-${HOME:-$ROOT/build}/.cache}/newton_euler_ros/wheelhouse}"
@@ -96,10 +99,13 @@ H_PKG="$(printf '%s %s' "$H_VENV" "$(hash_inputs \
   "$PKG_SRC/resource" "$PKG_SRC/config" "$PKG_SRC/launch" \
   "$PKG_SRC/newton_euler_ros/__init__.py" \
   "$ROOT/scripts/setup_env.sh")" | sha256sum | cut -d' ' -f1)"
+H_TOOLS="$(printf '%s %s' "$H_VENV" "$(hash_inputs \
+  "$TOOLS_SRC/pyproject.toml" "$TOOLS_SRC/newton_euler_tools/__init__.py" \
+  "$ROOT/scripts/setup_env.sh")" | sha256sum | cut -d' ' -f1)"
 
 if [[ "${SETUP_FORCE:-0}" != 1 && -x "$VENV/bin/python" ]] \
    && stamp_ok venv "$H_VENV" && stamp_ok interfaces "$H_IFACE" \
-   && stamp_ok package "$H_PKG"; then
+   && stamp_ok package "$H_PKG" && stamp_ok tools "$H_TOOLS"; then
   log "up to date (.venv; remove it or run 'make clean' to start over)"
   exit 0
 fi
@@ -141,7 +147,7 @@ venv_usable() {
 }
 
 if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok venv "$H_VENV"; then
-  log "step 1/3: virtualenv + pinned requirements"
+  log "step 1/4: virtualenv + pinned requirements"
   if ! venv_usable; then
     PY="$(find_python)" || die "Python $PY_MINOR not found; install it or set PYTHON=/path/to/python$PY_MINOR"
     [[ -e "$VENV" ]] && run rm -rf "$VENV"   # half-created or wrong Python
@@ -219,7 +225,7 @@ unset COLCON_PREFIX_PATH
 # ---------------------------------------------------------------------------
 # Step 2: newton_euler_interfaces -> .venv (lib/, share/, site-packages/).
 if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok interfaces "$H_IFACE"; then
-  log "step 2/3: build + install newton_euler_interfaces into .venv"
+  log "step 2/4: build + install newton_euler_interfaces into .venv"
   rm -f "$STAMPS/interfaces"   # a failed attempt may leave a half install
   command -v cmake >/dev/null || die "cmake not found (apt-get install cmake)"
   command -v c++ >/dev/null || die "no C++ compiler (apt-get install g++)"
@@ -247,7 +253,7 @@ fi
 # ---------------------------------------------------------------------------
 # Step 3: newton_euler_ros, editable.
 if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok package "$H_PKG"; then
-  log "step 3/3: install newton_euler_ros (editable) + data files into .venv"
+  log "step 3/4: install newton_euler_ros (editable) + data files into .venv"
   rm -f "$STAMPS/package"
   [[ -f "$PKG_SRC/newton_euler_ros/__init__.py" ]] \
     || die "newton_euler_ros/newton_euler_ros/__init__.py is missing"
@@ -290,6 +296,24 @@ from ament_index_python.packages import get_package_share_directory
 get_package_share_directory("newton_euler_ros")
 ' || die "newton_euler_ros does not import / is not in the ament index"
   stamp_write package "$H_PKG"
+fi
+
+# ---------------------------------------------------------------------------
+# Step 4: newton_euler_tools (tools/), editable: `python -m
+# newton_euler_tools.bench` etc. run from any directory, and edits take
+# effect without reinstalling.  Same pip options as step 3.
+if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok tools "$H_TOOLS"; then
+  log "step 4/4: install newton_euler_tools (editable) into .venv"
+  rm -f "$STAMPS/tools"
+  [[ -f "$TOOLS_SRC/newton_euler_tools/__init__.py" ]] \
+    || die "tools/newton_euler_tools/__init__.py is missing"
+  pip_filtered "$VENV/bin/python" -m pip install --progress-bar off -q \
+    --no-deps --no-build-isolation --use-pep517 -e "$TOOLS_SRC" \
+    --config-settings editable_mode=compat \
+    || die "pip install -e tools failed"
+  (cd / && "$VENV/bin/python" -c 'import newton_euler_tools') \
+    || die "newton_euler_tools does not import"
+  stamp_write tools "$H_TOOLS"
 fi
 
 log "done: $("$VENV/bin/python" -c 'import sys; print(sys.executable)'), $(du -sh "$VENV" | cut -f1)"

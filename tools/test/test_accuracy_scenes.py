@@ -16,10 +16,10 @@
 import dataclasses
 import math
 
-from newton_euler_ros.accuracy import scenes as S
 from newton_euler_ros.core import wrench_torques
 from newton_euler_ros.core.simulate import (SceneDynamics, simulate,
                                             tracking_controller)
+from newton_euler_tools.accuracy import scenes as S
 import numpy as np
 import pytest
 

@@ -12,9 +12,17 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""Run the accuracy/speed report: ``python -m newton_euler_ros.accuracy``."""
+"""
+Tests of the tools (tools/newton_euler_tools): benchmarks, report, demos.
+
+They run in ``make test`` with the package's tests (``pytest.ini``'s
+testpaths) and share the package's test helpers (``ros_harness``), whose
+folder is put on sys.path here.
+"""
+import os
 import sys
 
-from .report import main
-
-sys.exit(main())
+HELPERS = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__)))), 'newton_euler_ros', 'test')
+if HELPERS not in sys.path:
+    sys.path.insert(0, HELPERS)

@@ -70,8 +70,10 @@ def _compare(records, pairs):
     return out
 
 
-BASE_METHOD = {'tau': 'float64', 'D': 'float64, CRBA', 'C': 'float64, exact',
-               'g': 'float64'}
+BASE_METHOD = {'tau': 'float64', 'D': 'float64, CRBA',
+               'C': 'float64, composite, O(n^2)', 'g': 'float64',
+               'FD': 'float64, ABA, O(n)'}
+FLOAT32_METHOD = {'FD': 'float32, ABA'}
 
 
 def findings(records, context):
@@ -79,8 +81,8 @@ def findings(records, context):
     robots = _robots(records)
     out = []
     t_ratio, errs32, errs64, _ = _compare(records, [
-        (robot, q, base.replace('float64', 'float32'), base)
-        for robot in robots for q, base in BASE_METHOD.items()])
+        (robot, q, FLOAT32_METHOD.get(q, base.replace('float64', 'float32')),
+         base) for robot in robots for q, base in BASE_METHOD.items()])
     if t_ratio:
         typical = sorted(t_ratio)[len(t_ratio) // 2]
         verdict = ('float32 buys no time' if typical > 0.9 else
@@ -103,13 +105,27 @@ def findings(records, context):
             f'Newton-Euler recursions ({t_ratio[k]:.2f}x on {dofs[k][1]}, '
             f'{dofs[k][0]} links), at an error of {_span(e_crba, fmt_err)} '
             f'against {_span(e_ne, fmt_err)}.')
+    for quantity, fast, slow, what in (
+            ('C', 'float64, composite, O(n^2)', 'float64, n recursions',
+             'C(q, qd): the composite-body algorithm'),
+            ('FD', 'float64, ABA, O(n)', 'float64, Cholesky of D',
+             'Forward dynamics: the articulated-body algorithm')):
+        t_ratio, e_fast, e_slow, dofs = _compare(records, [
+            (robot, quantity, fast, slow) for robot in robots])
+        if t_ratio:
+            k = max(range(len(dofs)), key=lambda i: dofs[i][0])
+            out.append(
+                f'- **{what}** takes {_span(t_ratio, lambda x: f"{x:.2f}x")} '
+                f'the time of {slow.split(", ", 1)[1]} ({t_ratio[k]:.2f}x on '
+                f'{dofs[k][1]}, {dofs[k][0]} links), at an error of '
+                f'{_span(e_fast, fmt_err)} against {_span(e_slow, fmt_err)}.')
     t_ratio, e_fd, e_ex, _ = _compare(records, [
-        (robot, 'C', 'central differences of D', 'float64, exact')
+        (robot, 'C', 'central differences of D', 'float64, n recursions')
         for robot in robots])
     if t_ratio:
         out.append(
             f'- **C(q, qd) by finite differences of D** costs '
-            f'{_span(t_ratio, lambda x: f"{x:.0f}x")} the exact recursion '
+            f'{_span(t_ratio, lambda x: f"{x:.0f}x")} the n recursions '
             f'and loses digits: error {_span(e_fd, fmt_err)} (central '
             f'differences at the optimal step) against '
             f'{_span(e_ex, fmt_err)} exact.')
@@ -120,7 +136,8 @@ def findings(records, context):
         lines = []
         for q, peer in (('tau', 'Pinocchio rnea'), ('D', 'Pinocchio crba'),
                         ('C', 'Pinocchio computeCoriolisMatrix'),
-                        ('g', 'Pinocchio computeGeneralizedGravity')):
+                        ('g', 'Pinocchio computeGeneralizedGravity'),
+                        ('FD', 'Pinocchio aba')):
             ratio, a, b = _ratio(records, robot, q, BASE_METHOD[q], peer)
             if ratio is not None:
                 lines.append(f'{q} {ratio:.2f}x (error '
@@ -225,7 +242,7 @@ def render(records, context, images, scaling_img, scene_imgs, integ_img):
         'noise, not a ranking: every float64 method here is accurate to '
         'the last few bits.',
         '- Peers (Pinocchio, Robotics Toolbox for Python) run models built '
-        'from ours by `newton_euler_ros.peers`; their error includes '
+        'from ours by `newton_euler_tools.peers`; their error includes '
         'rebuilding the DH geometry as transforms.',
         '',
         '## Findings',
@@ -255,7 +272,7 @@ def render(records, context, images, scaling_img, scene_imgs, integ_img):
     scale = [r for r in records if r['section'] == 'scaling']
     if scale:
         lines += ['## Cost growth with the number of links', '',
-                  'Random chains (`newton_euler_ros.accuracy.chains`), one '
+                  'Random chains (`newton_euler_tools.accuracy.chains`), one '
                   'state each; the exponent is the least-squares slope of '
                   f'log time on log n for n >= {context["fit_from"]} (the '
                   'three largest chains; below them the fixed cost of a '

@@ -15,7 +15,7 @@
 """
 Closed-loop demo: simulator, inverse dynamics and a tracking controller.
 
-    python -m newton_euler_ros.demo [--scene NAME] [--duration T]
+    python -m newton_euler_tools.demo [--scene NAME] [--duration T]
                                     [--out DIR] [--quick]
 
 Runs the scene twice, each time as three ROS processes in a domain of
@@ -23,24 +23,28 @@ its own (discovery on localhost): robot_sim_node, inverse_dynamics_node
 (desired accelerations from the controller's reference) and
 tracking_controller_node, once with the feedforward and once with PD
 alone.  A probe in this process records joint states and commands.  The
-children are stopped with SIGINT and must exit 0.  Then plots (joint
+simulator starts its clock only once every node has discovered its peers
+(see :func:`run_graph`), so no command is lost at the start; the summary
+says how many commands the controller sent, the plant received and the
+probe recorded.  The children are stopped with SIGINT (the controller
+first) and must exit 0.  Then plots (joint
 tracking, torques split by term, tracking error) and ``summary.md`` are
 written to DIR (default out/demo).
 """
 import argparse
 import os
+import re
 import sys
 import time
 import warnings
 
+from newton_euler_ros.graph import CONTROLLER_REMAPS, ID, ros_args, SIM
 import numpy as np
 
 from .processes import ChildProcess
 
 SCENE = 'puma_payload_press'
 QUICK_DURATION = 1.0
-SIM = '/robot_sim_node'
-ID = '/inverse_dynamics_node'
 STARTUP_TIMEOUT = 120.0     # first run may compile the numba kernels
 
 
@@ -72,9 +76,17 @@ class Child(ChildProcess):
 
 
 class Recorder:
-    """An rclpy node in its own context recording the demo's topics."""
+    """
+    An rclpy node in its own context recording the demo's topics.
 
-    def __init__(self, domain):
+    With ``states_after_commands``, joint_states is subscribed only once
+    the commands' subscription is matched with a publisher (the
+    controller), so that a simulator counting this recorder among its
+    joint_states subscribers starts only when this recorder hears the
+    commands.
+    """
+
+    def __init__(self, domain, states_after_commands=False):
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import (DurabilityPolicy, QoSProfile,
@@ -95,10 +107,22 @@ class Recorder:
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
         self.node.create_subscription(Header, f'{SIM}/start', self._on_start,
                                       latched)
-        self.node.create_subscription(JointState, '/joint_states',
-                                      self._on_state, 1000)
-        self.node.create_subscription(Float64MultiArray, f'{SIM}/commands',
-                                      self._on_command, 1000)
+        self.cmd_sub = self.node.create_subscription(
+            Float64MultiArray, f'{SIM}/commands', self._on_command, 1000)
+        self._state_type = JointState
+        self.state_sub = None
+        self._states_after_commands = states_after_commands
+        self._subscribe_states()
+
+    def _subscribe_states(self):
+        # joint_states at once, or last: once the controller's commands
+        # are matched (the simulator counts this subscriber before it
+        # starts its clock)
+        if self.state_sub is None and (
+                not self._states_after_commands
+                or self.cmd_sub.get_publisher_count()):
+            self.state_sub = self.node.create_subscription(
+                self._state_type, '/joint_states', self._on_state, 1000)
 
     def _on_start(self, msg):
         self.t0 = msg.stamp.sec + msg.stamp.nanosec * 1e-9
@@ -123,7 +147,17 @@ class Recorder:
         return self.states[-1][0] - self.t0
 
     def spin_once(self, timeout=0.02):
+        self._subscribe_states()
         self.executor.spin_once(timeout_sec=timeout)
+
+    def drain(self, quiet=0.3, limit=5.0):
+        """Spin until no command arrived for ``quiet`` s (at most limit)."""
+        end = time.monotonic() + limit
+        count, since = len(self.commands), time.monotonic()
+        while time.monotonic() - since < quiet and time.monotonic() < end:
+            self.spin_once(0.02)
+            if len(self.commands) != count:
+                count, since = len(self.commands), time.monotonic()
 
     def close(self):
         self.executor.shutdown()
@@ -143,21 +177,39 @@ def wait_for(recorder, children, predicate, what):
         recorder.spin_once(0.05)
 
 
+COUNT = re.compile(r'commands (sent|received): (\d+)')
+
+
+def logged_count(child, what):
+    """Return the count a node logged on exit (``commands sent: N``)."""
+    counts = dict(COUNT.findall(child.log()))
+    if what not in counts:
+        raise DemoError(f'{child.label} did not log its "commands {what}" '
+                        f'count; see {child.log_path}')
+    return int(counts[what])
+
+
 def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
     """Run the three nodes once; return the recorded arrays."""
     ff = 'true' if feedforward else 'false'
     children = []
-    recorder = Recorder(domain)
+    recorder = Recorder(domain, states_after_commands=True)
     status = {}
     try:
-        # The simulator waits for a controller; the controller starts last,
-        # once everything else (this recorder too) is up and discovered.
-        children.append(Child(
+        # The simulator starts its clock once every node has discovered its
+        # peers: it waits for its three joint_states subscribers (this
+        # recorder, the controller, the ID node); the controller and this
+        # recorder subscribe to joint_states only once the controller's
+        # commands are matched with the simulator and this recorder (and,
+        # with feedforward, its ~/feedforward and ~/reference with the ID
+        # node); the simulator's GRACE second covers the ID node's side.
+        # The controller starts last.
+        sim = Child(
             f'{label}_robot_sim_node', 'newton_euler_ros.nodes.'
             'robot_sim_node', ['-p', f'scene:={scene_arg}',
-                               # this recorder, the controller, the ID node
                                '-p', 'wait_for_subscribers:=3'],
-            domain, log_dir))
+            domain, log_dir)
+        children.append(sim)
         children.append(Child(
             f'{label}_inverse_dynamics_node',
             'newton_euler_ros.nodes.inverse_dynamics_node',
@@ -167,12 +219,14 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
                  lambda: recorder.publishers(f'{ID}/torques') >= 1
                  and recorder.subscribers(f'{SIM}/commands') >= 1,
                  'robot_sim_node and inverse_dynamics_node')
-        children.append(Child(
+        controller = Child(
             f'{label}_tracking_controller_node',
             'newton_euler_ros.nodes.tracking_controller_node',
             ['-p', f'scene:={scene_arg}', '-p', f'feedforward:={ff}',
-             '-r', f'reference:={ID}/reference',
-             '-r', f'commands:={SIM}/commands'], domain, log_dir))
+             # the simulator and this recorder
+             '-p', 'wait_for_subscribers:=2',
+             *ros_args(CONTROLLER_REMAPS)], domain, log_dir)
+        children.append(controller)
         wait_for(recorder, children, lambda: recorder.t0 is not None,
                  'the simulation start')
         print(f'[{label}] nodes up in domain {domain}; simulating '
@@ -195,9 +249,14 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
             if time.monotonic() > end:
                 raise DemoError(f'[{label}] simulation did not reach '
                                 f't = {duration} s in time')
+        # the controller first: then no command is in flight when the
+        # recorder and the simulator give their counts
+        status[controller.label] = controller.stop()
+        recorder.drain()
     finally:
         for child in reversed(children):
-            status[child.label] = child.stop()
+            if child.label not in status:
+                status[child.label] = child.stop()
         recorder.close()
     bad = {k: v for k, v in status.items() if v != 0}
     if bad:
@@ -211,13 +270,19 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
     order = np.argsort(stamps[keep], kind='stable')
     rows = [r for r, k in zip(recorder.states, keep) if k]
     rows = [rows[i] for i in order]
-    return {
+    run = {
         't': stamps[keep][order],
         'q': np.array([r[1] for r in rows]),
         'qd': np.array([r[2] for r in rows]),
         'tau': np.array([r[3] for r in rows]),
         'commands': len(recorder.commands),
+        'sent': logged_count(controller, 'sent'),
+        'received': logged_count(sim, 'received'),
     }
+    print(f'[{label}] commands: {run["sent"]} sent by the controller, '
+          f'{run["received"]} received by the plant, {run["commands"]} '
+          f'recorded', flush=True)
+    return run
 
 
 def tracking(scene, run):
@@ -230,9 +295,9 @@ def tracking(scene, run):
 
 def torque_terms(scene, run):
     """Split the torques of a recorded run into the scene's terms."""
-    from .core import coriolis_matrix, gravity_torques, jacobian, \
-        mass_matrix
-    from .core.simulate import SceneDynamics
+    from newton_euler_ros.core import (coriolis_matrix, gravity_torques,
+                                       jacobian, mass_matrix)
+    from newton_euler_ros.core.simulate import SceneDynamics
     dyn = SceneDynamics(scene)
     model, eff = scene.model, scene.effects
     t, q, qd = run['t'], run['q'], run['qd']
@@ -355,16 +420,24 @@ def summary(scene, runs, rms, files, duration, wall):
         '## Tracking',
         '',
         '| controller | RMS error [rad] | max error [rad] | joint states '
-        '| commands |',
-        '|---|---|---|---|---|',
+        '| commands sent | received by the plant | recorded |',
+        '|---|---|---|---|---|---|---|',
     ]
     for key, label in (('feedforward', 'PD + feedforward'),
                        ('pd', 'PD alone')):
         run = runs[key]
         lines.append(f'| {label} | {rms[key]:.3e} | '
                      f'{np.abs(run["err"]).max():.3e} | {len(run["t"])} | '
+                     f'{run["sent"]} | {run["received"]} | '
                      f'{run["commands"]} |')
     lines += [
+        '',
+        'Commands: sent by tracking_controller_node (its count on exit), '
+        'received by robot_sim_node (its count on exit) and recorded by '
+        "this demo's probe, over the whole run: the controller answers "
+        'joint states from the start until it is stopped, first of the '
+        'nodes, so they may exceed the joint states recorded in '
+        '[0, duration].',
         '',
         f'RMS with feedforward: {rms["feedforward"]:.6e} rad',
         f'RMS without feedforward: {rms["pd"]:.6e} rad',
@@ -378,7 +451,7 @@ def summary(scene, runs, rms, files, duration, wall):
         '',
         'Not timed here: a demo shares the CPU with five processes, and '
         'timings taken beside them contradict each other. `make bench` '
-        '(`python -m newton_euler_ros.bench_effects`) times each effect '
+        '(`python -m newton_euler_tools.bench_effects`) times each effect '
         'side by side on a quiet machine.',
     ]
     lines += ['', '## Plots', ''] + [f'![{f}]({f})' for f in files] + ['']
@@ -388,7 +461,7 @@ def summary(scene, runs, rms, files, duration, wall):
 def main(argv=None):
     """Run the closed-loop demo; return the exit status."""
     parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_ros.demo',
+        prog='python -m newton_euler_tools.demo',
         description='Closed-loop ROS 2 demo: tracking with and without '
                     'Newton-Euler feedforward.')
     parser.add_argument('--scene', default=SCENE,
@@ -403,8 +476,8 @@ def main(argv=None):
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
-    from .core import NewtonEulerError
-    from .core.scene import load_scene
+    from newton_euler_ros.core import NewtonEulerError
+    from newton_euler_ros.core.scene import load_scene
     try:
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')

@@ -41,14 +41,16 @@ the whole-simulation wall times, which are one run each.
 import math
 import warnings
 
+from newton_euler_ros.core import (inverse_dynamics, inverse_dynamics_batch,
+                                   Workspace)
+from newton_euler_ros.core.robot_file import RobotFileWarning
+from newton_euler_ros.core.scene import INTEGRATORS, load_scene
+from newton_euler_ros.core.simulate import (friction_torque, integrator_step,
+                                            SceneDynamics, simulate,
+                                            tracking_controller)
 import numpy as np
 
 from ..bench import Timer
-from ..core import inverse_dynamics, inverse_dynamics_batch, Workspace
-from ..core.robot_file import RobotFileWarning
-from ..core.scene import INTEGRATORS, load_scene
-from ..core.simulate import (integrator_step, SceneDynamics, simulate,
-                             tracking_controller)
 
 SCENES = ('puma_payload_press', 'panda_orbit_slow', 'panda_slow_earth')
 CONTROL_PERIOD = 4e-3          # s: the sweep's controller, 250 Hz, held
@@ -145,7 +147,7 @@ def scene_torques_batch(scene, Q, QD, QDD, W=None, frame='base', ws=None,
     if eff.armature:
         tau += scene.armature * QDD
     if eff.friction:
-        tau += scene.viscous * QD + scene.coulomb * np.sign(QD)
+        tau += friction_torque(scene, QD)
     return tau
 
 
@@ -252,7 +254,7 @@ def effect_subsets(scene, quick=False):
     if eff.armature:
         outside += scene.armature * QDD
     if eff.friction:
-        outside += scene.viscous * QD + scene.coulomb * np.sign(QD)
+        outside += friction_torque(scene, QD)
     common = (f'truth: full + wrench along the reference, {T.size} states '
               f'at {scene.rate:g} Hz over {T[-1]:g} s')
     own = (eff.velocity_products, True, eff.wrench)

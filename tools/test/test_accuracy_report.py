@@ -28,9 +28,9 @@ import subprocess
 import sys
 import warnings
 
-from newton_euler_ros.accuracy import chains, plots, scaling
-from newton_euler_ros.accuracy.arithmetic import coriolis_by_differences
 from newton_euler_ros.core import coriolis_matrix, load_robot, mass_matrix
+from newton_euler_tools.accuracy import chains, plots, scaling
+from newton_euler_tools.accuracy.arithmetic import coriolis_by_differences
 import numpy as np
 import pytest
 
@@ -107,7 +107,7 @@ def quick_report(tmp_path_factory):
     out = tmp_path_factory.mktemp('accuracy')
     env = dict(os.environ)
     proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.accuracy', '--quick',
+        [sys.executable, '-m', 'newton_euler_tools.accuracy', '--quick',
          '--out', str(out)], capture_output=True, text=True, env=env,
         timeout=600)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
@@ -148,14 +148,26 @@ def test_quick_report_errors_are_physically_ordered(quick_report):
         bound = 10 * n * EPS
         for q, m in (('tau', 'float64'), ('g', 'float64'),
                      ('D', 'float64, n recursions'), ('D', 'float64, CRBA'),
-                     ('C', 'float64, exact')):
+                     ('C', 'float64, n recursions')):
             assert _arith(records, robot, q, m)['error'] <= bound, (robot, q, m)
         # float32 really is single precision: far above float64 round-off,
         # and still sane (eps32 = 1.2e-7)
+        # the composite C sums moment arms about frame 0 (see
+        # test_highprec): a looser constant
+        err = _arith(records, robot, 'C', 'float64, composite, O(n^2)')
+        assert err['error'] <= 100 * n * EPS, (robot, err['error'])
         for q, m in (('tau', 'float32'), ('D', 'float32, CRBA'),
-                     ('C', 'float32, exact')):
+                     ('C', 'float32, n recursions'),
+                     ('C', 'float32, composite, O(n^2)')):
             err = _arith(records, robot, q, m)['error']
             assert 1e3 * EPS < err < 1e-7 * 100 * n, (robot, q, m, err)
+        # forward dynamics amplifies by cond(D) (1e3..1e6 here): both
+        # methods well inside single precision, float32 well outside
+        for m in ('float64, ABA, O(n)', 'float64, Cholesky of D'):
+            err = _arith(records, robot, 'FD', m)['error']
+            assert err < 1e-10, (robot, m, err)
+        err = _arith(records, robot, 'FD', 'float32, ABA')['error']
+        assert 1e3 * EPS < err < 1e-2, (robot, err)
         fd = _arith(records, robot, 'C', 'central differences of D')
         assert 1e3 * EPS < fd['error'] < 1e-6, (robot, fd['error'])
 
@@ -163,14 +175,14 @@ def test_quick_report_errors_are_physically_ordered(quick_report):
 def test_report_rerenders_from_its_records(quick_report, tmp_path):
     out, _, _, _ = quick_report
     proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.accuracy', '--from-records',
+        [sys.executable, '-m', 'newton_euler_tools.accuracy', '--from-records',
          str(out / 'accuracy' / 'records.json'), '--out', str(tmp_path)],
         capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     again = (tmp_path / 'accuracy-vs-time.md').read_text(encoding='utf-8')
     assert again == (out / 'accuracy-vs-time.md').read_text(encoding='utf-8')
     bad = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.accuracy', '--from-records',
+        [sys.executable, '-m', 'newton_euler_tools.accuracy', '--from-records',
          str(tmp_path / 'missing.json')], capture_output=True, text=True,
         timeout=300)
     assert bad.returncode == 2 and 'cannot read records' in bad.stderr

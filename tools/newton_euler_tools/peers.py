@@ -15,7 +15,7 @@
 """
 Peer-library models built from a :class:`~newton_euler_ros.core.RobotModel`.
 
-Used by :mod:`newton_euler_ros.bench` to time the same robot in other
+Used by :mod:`newton_euler_tools.bench` to time the same robot in other
 rigid-body dynamics libraries, and usable on its own to cross-check our
 results against theirs.  Neither peer is a dependency of the package: every
 builder imports its library lazily and raises ``ImportError`` when it is
@@ -56,9 +56,8 @@ Robotics Toolbox for Python (``import roboticstoolbox``)
 import math
 import os
 
+from newton_euler_ros.core.model import MODIFIED, REVOLUTE, STANDARD
 import numpy as np
-
-from .core.model import MODIFIED, REVOLUTE, STANDARD
 
 
 def _rz(theta):

@@ -15,7 +15,7 @@
 """
 A URDF arm costs what a DH arm of the same size costs, per call.
 
-    python -m newton_euler_ros.bench_urdf [--quick]
+    python -m newton_euler_tools.bench_urdf [--quick]
 
 Times tau, D (CRBA), C and g side by side in one run on: the Puma 560 from
 its DH table; the same Puma written as URDF and loaded back (every joint a
@@ -27,12 +27,12 @@ not depend on the source: the ratio column shows it.
 import argparse
 import warnings
 
+from newton_euler_ros.core import (coriolis_matrix, gravity_torques,
+                                   inverse_dynamics, load_robot, mass_matrix)
+from newton_euler_ros.core.urdf import load_urdf, model_to_urdf
 import numpy as np
 
 from .bench_effects import _min_time
-from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
-                   load_robot, mass_matrix)
-from .core.urdf import load_urdf, model_to_urdf
 
 PUBLISHED = (('ur5 (URDF)', 'ur_description/urdf/ur5_robot.urdf', 'tool0'),
              ('panda (URDF)', 'panda_description/urdf/panda.urdf',

@@ -21,13 +21,14 @@ float64 parameters and the float64 states as exact.  Its results, rounded
 once to float64, are the truth every method here is measured against
 (their own rounding is 1e-50, far below any float64 error).
 """
-from ..core.highprec import HighPrecisionModel
+from newton_euler_ros.core.highprec import HighPrecisionModel
 
-QUANTITIES = ('tau', 'D', 'C', 'g')
+# FD: the accelerations for the state's qdd vector taken as the torques
+QUANTITIES = ('tau', 'D', 'C', 'g', 'FD')
 
 
 class GroundTruth:
-    """tau, D, C and g of one model at a list of states, in mpmath."""
+    """tau, D, C, g and FD of one model at a list of states, in mpmath."""
 
     def __init__(self, model, states, dps=50):
         self.model = model
@@ -49,6 +50,10 @@ class GroundTruth:
                 out = hp.coriolis_matrix(q, qd)
             elif quantity == 'g':
                 out = hp.inverse_dynamics(q)
+            elif quantity == 'FD':
+                # D and the bias at 50 digits, solved by LU: independent of
+                # both float64 methods
+                out = hp.forward_dynamics(q, qd, qdd, method='cholesky')
             else:
                 raise ValueError(f'unknown quantity {quantity!r}; one of '
                                  f'{", ".join(QUANTITIES)}')

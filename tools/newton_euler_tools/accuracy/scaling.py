@@ -24,12 +24,14 @@ from Python hides the growth).
 import math
 import warnings
 
+from newton_euler_ros.core import (coriolis_matrix, forward_dynamics,
+                                   gravity_torques, inverse_dynamics,
+                                   inverse_dynamics_batch, mass_matrix,
+                                   Workspace)
 import numpy as np
 
 from .arithmetic import coriolis_by_differences
 from .chains import random_chain, random_states
-from ..core import (coriolis_matrix, gravity_torques, inverse_dynamics,
-                    inverse_dynamics_batch, mass_matrix, Workspace)
 
 FULL_SIZES = (3, 6, 12, 25, 50, 100, 200)
 QUICK_SIZES = (3, 6, 12, 25)
@@ -44,14 +46,20 @@ OPERATIONS = {
     'D, CRBA': 'mass_matrix(model, q, ws=ws, out=D)',
     'D, n recursions':
         "mass_matrix(model, q, method='newton_euler', ws=ws, out=D)",
-    'C, exact': 'coriolis_matrix(model, q, qd, ws=ws, out=C)',
+    'C, composite': 'coriolis_matrix(model, q, qd, ws=ws, out=C)',
+    'C, n recursions':
+        "coriolis_matrix(model, q, qd, method='newton_euler', ws=ws, out=C)",
     'C, central differences of D': 'fd(model, q, qd, ws=ws)',
+    'FD, ABA': 'forward_dynamics(model, q, qd, qdd, ws=ws, out=tau)',
+    'FD, Cholesky': "forward_dynamics(model, q, qd, qdd, method='cholesky', "
+                    'ws=ws, out=tau)',
 }
 PEER_OPERATIONS = {
     'Pinocchio rnea': 'pin.rnea(pm, pd, q, qd, qdd)',
     'Pinocchio crba': 'pin.crba(pm, pd, q)',
     'Pinocchio computeCoriolisMatrix':
         'pin.computeCoriolisMatrix(pm, pd, q, qd)',
+    'Pinocchio aba': 'pin.aba(pm, pd, q, qd, qdd)',
 }
 
 
@@ -69,6 +77,7 @@ def _namespace(model):
             'inverse_dynamics_batch': inverse_dynamics_batch,
             'gravity_torques': gravity_torques, 'mass_matrix': mass_matrix,
             'coriolis_matrix': coriolis_matrix,
+            'forward_dynamics': forward_dynamics,
             'fd': coriolis_by_differences}
 
 

@@ -15,7 +15,7 @@
 """
 What trajectory feedforward costs per point.
 
-    python -m newton_euler_ros.bench_trajectory [--quick]
+    python -m newton_euler_tools.bench_trajectory [--quick]
 
 Times :func:`~newton_euler_ros.core.trajectory.trajectory_efforts` (the
 CLI's ``feedforward`` and the node's ``~/trajectory_in`` path) on a
@@ -27,10 +27,9 @@ import argparse
 import time
 import warnings
 
+from newton_euler_ros.core import inverse_dynamics, load_robot
+from newton_euler_ros.core.trajectory import trajectory_efforts
 import numpy as np
-
-from .core import inverse_dynamics, load_robot
-from .core.trajectory import trajectory_efforts
 
 POINTS = 1000
 

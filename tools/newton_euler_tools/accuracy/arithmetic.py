@@ -17,7 +17,7 @@ Arithmetic and algorithms, per robot: microseconds and error vs truth.
 
 For tau, D, C and g of one model this measures, side by side in one run
 (the repeats of one quantity's methods interleaved by
-:class:`newton_euler_ros.bench.Timer`):
+:class:`newton_euler_tools.bench.Timer`):
 
 - our float64 path and the float32 path (the same kernels compiled for
   float32; inputs rounded to float32 count towards its error);
@@ -26,21 +26,22 @@ For tau, D, C and g of one model this measures, side by side in one run
 - C exact (the Christoffel-form recursion) and C from finite differences
   of D through the Christoffel symbols, central and forward;
 - Pinocchio and Robotics Toolbox for Python, where installed, on models
-  built from ours by :mod:`newton_euler_ros.peers`.
+  built from ours by :mod:`newton_euler_tools.peers`.
 
 The error of a method is the largest normwise relative error over the
 states (see :func:`.truth.relative_error`).
 """
 import warnings
 
+from newton_euler_ros.core import (coriolis_matrix, forward_dynamics,
+                                   gravity_torques, inverse_dynamics,
+                                   mass_matrix, Workspace)
+from newton_euler_ros.core.float32 import Float32Dynamics
+from newton_euler_ros.core.highprec import relative_error
 import numpy as np
 
 from .truth import QUANTITIES
 from .. import peers
-from ..core import (coriolis_matrix, gravity_torques, inverse_dynamics,
-                    mass_matrix, Workspace)
-from ..core.float32 import Float32Dynamics
-from ..core.highprec import relative_error
 
 EPS = float(np.finfo(np.float64).eps)
 # Central differences balance truncation (h^2) against rounding (eps / h):
@@ -113,7 +114,9 @@ def our_methods(model):
           'inverse_dynamics': inverse_dynamics, 'mass_matrix': mass_matrix,
           'coriolis_matrix': coriolis_matrix,
           'gravity_torques': gravity_torques,
-          'fd': coriolis_by_differences,
+          'forward_dynamics': forward_dynamics,
+          'fd': coriolis_by_differences, 'a': np.empty(n),
+          'a32': np.empty(n, np.float32),
           'tau': np.empty(n), 'D': np.empty((n, n)), 'C': np.empty((n, n)),
           'g': np.empty(n), 'tau32': np.empty(n, np.float32),
           'D32': np.empty((n, n), np.float32),
@@ -133,10 +136,17 @@ def our_methods(model):
                  'f32.mass_matrix(q, out=D32)', ns)
     yield Method('D', 'float32, n recursions', 'float32',
                  "f32.mass_matrix(q, method='newton_euler', out=D32)", ns)
-    yield Method('C', 'float64, exact', 'ours',
-                 'coriolis_matrix(model, q, qd, ws=ws, out=C)', ns)
-    yield Method('C', 'float32, exact', 'float32',
+    yield Method('C', 'float64, composite, O(n^2)', 'ours',
+                 'coriolis_matrix(model, q, qd, ws=ws, out=C)', ns,
+                 note='the default of coriolis_matrix')
+    yield Method('C', 'float64, n recursions', 'ours',
+                 "coriolis_matrix(model, q, qd, method='newton_euler', ws=ws, "
+                 'out=C)', ns)
+    yield Method('C', 'float32, composite, O(n^2)', 'float32',
                  'f32.coriolis_matrix(q, qd, out=C32)', ns)
+    yield Method('C', 'float32, n recursions', 'float32',
+                 "f32.coriolis_matrix(q, qd, method='newton_euler', "
+                 'out=C32)', ns)
     yield Method('C', 'central differences of D', 'fd',
                  'fd(model, q, qd, h_c, True, ws=ws)', ns,
                  note=f'2n CRBA calls, h = eps^(1/3) = {CENTRAL_STEP:.1e}')
@@ -147,6 +157,15 @@ def our_methods(model):
                  'gravity_torques(model, q, ws=ws, out=g)', ns)
     yield Method('g', 'float32', 'float32', 'f32.gravity_torques(q, out=g32)',
                  ns)
+    # forward dynamics with the state's qdd as the torques
+    yield Method('FD', 'float64, ABA, O(n)', 'ours',
+                 'forward_dynamics(model, q, qd, qdd, ws=ws, out=a)', ns,
+                 note='the default of forward_dynamics')
+    yield Method('FD', 'float64, Cholesky of D', 'ours',
+                 "forward_dynamics(model, q, qd, qdd, method='cholesky', "
+                 'ws=ws, out=a)', ns)
+    yield Method('FD', 'float32, ABA', 'float32',
+                 'f32.forward_dynamics(q, qd, qdd, out=a32)', ns)
 
 
 def _symmetric_from_upper(M):
@@ -172,6 +191,8 @@ def peer_methods(model, notes):
                      'pin.computeCoriolisMatrix(pm, pd, q, qd)', ns)
         yield Method('g', 'Pinocchio computeGeneralizedGravity', 'peer',
                      'pin.computeGeneralizedGravity(pm, pd, q)', ns)
+        yield Method('FD', 'Pinocchio aba', 'peer',
+                     'pin.aba(pm, pd, q, qd, qdd)', ns)
     try:
         import roboticstoolbox  # noqa: F401
     except Exception as exc:
@@ -186,6 +207,8 @@ def peer_methods(model, notes):
         yield Method('D', 'RTB inertia', 'peer', 'robot.inertia(q)', ns)
         yield Method('C', 'RTB coriolis', 'peer', 'robot.coriolis(q, qd)', ns)
         yield Method('g', 'RTB gravload', 'peer', 'robot.gravload(q)', ns)
+        yield Method('FD', 'RTB accel', 'peer', 'robot.accel(q, qd, qdd)',
+                     ns)
 
 
 def measure_robot(model, truth, timer, use_peers=True, notes=None,

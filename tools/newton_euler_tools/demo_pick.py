@@ -15,7 +15,7 @@
 """
 Pick-and-place demo: trajectory efforts and a payload picked up mid-run.
 
-    python -m newton_euler_ros.demo_pick [--out DIR] [--quick]
+    python -m newton_euler_tools.demo_pick [--out DIR] [--quick]
 
 A planner's trajectory (positions, velocities, accelerations, no
 efforts) goes to inverse_dynamics_node's ``~/trajectory_in``; the node
@@ -39,12 +39,12 @@ import sys
 import time
 import warnings
 
+from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import base_domain, Child, DemoError, Recorder, SIM, wait_for
+from .demo import base_domain, Child, DemoError, Recorder, wait_for
 
 SCENE = 'puma_pick_and_place'
-ID = '/inverse_dynamics_node'
 # 3 kg held at the flange origin, the Puma's wrist centre: a load on the
 # arm joints 1-3 (the wrist axes pass through it)
 PAYLOAD = {'mass': 3.0, 'com': [0.0, 0.0, 0.0],
@@ -241,15 +241,15 @@ def plot(runs, path):
 def main(argv=None):
     """Run both scenarios; return the exit status."""
     parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_ros.demo_pick',
+        prog='python -m newton_euler_tools.demo_pick',
         description=__doc__.strip().split('\n')[0])
     parser.add_argument('--out', default=os.path.join('out', 'demo_pick'))
     parser.add_argument('--quick', action='store_true',
                         help='stop 0.6 s after the pick')
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
-    from .core import load_robot
-    from .core.scene import load_scene
+    from newton_euler_ros.core import load_robot
+    from newton_euler_ros.core.scene import load_scene
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
         scene = load_scene(SCENE)

@@ -15,7 +15,7 @@
 """
 echo_node: the inverse-dynamics node's message work without the dynamics.
 
-The latency floor for :mod:`newton_euler_ros.latency_bench`.  It takes the
+The latency floor for :mod:`newton_euler_tools.latency_bench`.  It takes the
 same inputs and produces the same outputs as ``inverse_dynamics_node``, with
 the same QoS and the same executor (``common.run_node``), but computes
 nothing: the "torques" are a copy of the positions.
@@ -28,17 +28,20 @@ Publishes
     same values)
 
 Parameters ``qos.depth`` (10) and ``qos.reliability`` (``reliable`` or
-``best_effort``) mirror the real node's.
+``best_effort``) are the real node's: declared from its schema, with its
+descriptions and validation (a bad value refuses to start, exit
+status 2).
 
-    python -m newton_euler_ros.nodes.echo_node
+    python -m newton_euler_tools.echo_node
 """
 import sys
 
+from newton_euler_ros.nodes.common import (declare_parameters, qos_profile,
+                                           run_node)
+from newton_euler_ros.parameters import load_specs
 from rclpy.node import Node
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray
-
-from .common import ConfigurationError, qos_profile, run_node
 
 
 class EchoNode(Node):
@@ -46,14 +49,10 @@ class EchoNode(Node):
 
     def __init__(self, **kwargs):
         super().__init__('echo_node', **kwargs)
-        depth = self.declare_parameter('qos.depth', 10).value
-        reliability = self.declare_parameter('qos.reliability',
-                                             'reliable').value
-        if depth < 1 or reliability not in ('reliable', 'best_effort'):
-            raise ConfigurationError(
-                f'qos.depth {depth} (>= 1) or qos.reliability '
-                f'{reliability!r} (reliable, best_effort)')
-        qos = qos_profile(depth, reliability)
+        p = declare_parameters(self, [
+            spec for spec in load_specs('inverse_dynamics_node')
+            if spec.name in ('qos.depth', 'qos.reliability')])
+        qos = qos_profile(p['qos.depth'], p['qos.reliability'])
         self.cmd_pub = self.create_publisher(Float64MultiArray,
                                              '~/torque_command', qos)
         self.torque_pub = self.create_publisher(JointState, '~/torques', qos)
@@ -78,7 +77,7 @@ class EchoNode(Node):
 
 
 def main(args=None):
-    """Entry point: ``python -m newton_euler_ros.nodes.echo_node``."""
+    """Entry point: ``python -m newton_euler_tools.echo_node``."""
     return run_node(EchoNode, 'echo_node', args)
 
 

@@ -22,9 +22,8 @@ the same chain.
 """
 import math
 
+from newton_euler_ros.core.model import make_model, pose_matrix, rpy_matrix
 import numpy as np
-
-from ..core.model import make_model, pose_matrix, rpy_matrix
 
 
 def random_inertia(rng, mass, size):

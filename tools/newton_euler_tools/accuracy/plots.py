@@ -97,19 +97,21 @@ def _panel(ax, points, title, xlabel='microseconds per call',
 
 
 def robot_pareto(records, robot, path):
-    """2x2 panels (tau, D, C, g): error against time for every method."""
+    """Panels (tau, D, C, g, FD): error against time for every method."""
     plt = _pyplot()
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8.5))
+    fig, axes = plt.subplots(2, 3, figsize=(15, 8.5))
+    axes.flat[-1].set_visible(False)
     rows = [r for r in records if r['section'] == 'arithmetic'
             and r['robot'] == robot]
     dof = rows[0]['dof'] if rows else '?'
-    for ax, quantity in zip(axes.flat, ('tau', 'D', 'C', 'g')):
+    for ax, quantity in zip(axes.flat, ('tau', 'D', 'C', 'g', 'FD')):
         points = [(r['us'], r['error'], r['method'], r['family'])
                   for r in rows if r['quantity'] == quantity]
         _panel(ax, points, {'tau': 'tau = inverse dynamics',
                             'D': 'D(q) mass matrix',
                             'C': 'C(q, qd) Coriolis matrix',
-                            'g': 'g(q) gravity torques'}[quantity])
+                            'g': 'g(q) gravity torques',
+                            'FD': 'qdd = forward dynamics'}[quantity])
     fig.suptitle(f'{robot} ({dof} joints): error against time; lower left '
                  f'is better', fontsize=11)
     fig.tight_layout()

@@ -15,9 +15,9 @@
 """
 Run every measurement; print the table; write the report and its plots.
 
-    python -m newton_euler_ros.accuracy [--quick] [--out DIR] [--no-peers]
+    python -m newton_euler_tools.accuracy [--quick] [--out DIR] [--no-peers]
                                         [--robot NAME ...] [--no-scenes]
-    python -m newton_euler_ros.accuracy --from-records JSON [--out DIR]
+    python -m newton_euler_tools.accuracy --from-records JSON [--out DIR]
 
 Writes ``DIR/accuracy-vs-time.md`` (default ``docs/``), its PNGs under
 ``DIR/accuracy/`` and every record as ``DIR/accuracy/records.json``.
@@ -33,6 +33,8 @@ import sys
 import time
 import warnings
 
+from newton_euler_ros.core import load_robot
+from newton_euler_ros.core.robot_file import bundled_robots
 import numpy as np
 
 from .arithmetic import EPS, measure_robot
@@ -41,11 +43,10 @@ from .scaling import fit_start, FULL_SIZES, measure_scaling, QUICK_SIZES
 from .truth import GroundTruth
 from .. import peers
 from ..bench import Timer
-from ..core import load_robot
-from ..core.robot_file import bundled_robots
 
 CHAIN_SIZES = (6, 30, 100)
-QUANTITY_LABELS = {'tau': 'tau', 'D': 'D(q)', 'C': 'C(q,qd)', 'g': 'g(q)'}
+QUANTITY_LABELS = {'tau': 'tau', 'D': 'D(q)', 'C': 'C(q,qd)', 'g': 'g(q)',
+                   'FD': 'qdd (FD)'}
 
 
 # --------------------------------------------------------------------------
@@ -274,7 +275,7 @@ def scene_tables(records):
 def main(argv=None):
     """Run the report from the command line; return the exit status."""
     parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_ros.accuracy',
+        prog='python -m newton_euler_tools.accuracy',
         description='Measure what accuracy costs in time and write '
                     'docs/accuracy-vs-time.md with its plots.')
     parser.add_argument('--quick', action='store_true',
@@ -313,7 +314,7 @@ def main(argv=None):
                    date=datetime.date.today().isoformat(),
                    machine=f'{platform.machine()}, {os.cpu_count()} cpus, '
                            f'{platform.platform()}',
-                   command='python -m newton_euler_ros.accuracy'
+                   command='python -m newton_euler_tools.accuracy'
                            + (' --quick' if args.quick else ''))
     from .markdown import write_report
     path = write_report(records, context, args.out)

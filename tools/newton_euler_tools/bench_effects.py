@@ -15,7 +15,7 @@
 """
 What each effect of a scene costs: time per inverse-dynamics call.
 
-    python -m newton_euler_ros.bench_effects [SCENE ...] [--quick]
+    python -m newton_euler_tools.bench_effects [SCENE ...] [--quick]
 
 For each scene, times the scene's feedforward torques (the call the
 inverse-dynamics node and the simulator's controller make) with every
@@ -27,10 +27,9 @@ import dataclasses
 import time
 import warnings
 
+from newton_euler_ros.core.scene import load_scene
+from newton_euler_ros.core.simulate import SceneDynamics
 import numpy as np
-
-from .core.scene import load_scene
-from .core.simulate import SceneDynamics
 
 EFFECTS = ('gravity', 'velocity_products', 'payload', 'wrench', 'friction',
            'armature')

@@ -20,6 +20,7 @@ localhost-only discovery.  LD_LIBRARY_PATH is inherited untouched: the
 ROS wheels' bootstrap set it, and a child with a replaced one cannot
 import rclpy.
 """
+import ctypes
 import os
 import signal
 import subprocess
@@ -34,20 +35,62 @@ def ros_env(domain):
     return env
 
 
-class ChildProcess:
-    """A node started as a child process, its output in a log file."""
+_PR_SET_PDEATHSIG = 1
+try:    # Linux prctl(2), or None elsewhere
+    prctl = ctypes.CDLL(None, use_errno=True).prctl
+    prctl.argtypes = [ctypes.c_int, ctypes.c_ulong, ctypes.c_ulong,
+                      ctypes.c_ulong, ctypes.c_ulong]
+except (OSError, AttributeError):
+    prctl = None
 
-    def __init__(self, cmd, domain, log_path, label=None):
+
+def _die_with_parent():
+    # runs in the child between fork and exec: SIGKILL when we die
+    prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+
+
+class ChildProcess:
+    """
+    A node started as a child process, its output in a log file.
+
+    ``env`` adds variables to :func:`ros_env`'s; ``die_with_parent`` has
+    the kernel kill the child if this process dies first (Linux).
+    """
+
+    def __init__(self, cmd, domain, log_path, label=None, env=None,
+                 die_with_parent=False):
+        self.cmd = cmd
         self.label = label or os.path.basename(log_path)
         self.log_path = log_path
+        os.makedirs(os.path.dirname(os.path.abspath(log_path)), exist_ok=True)
         self._log = open(log_path, 'w')
-        self.proc = subprocess.Popen(cmd, env=ros_env(domain),
-                                     stdout=self._log,
-                                     stderr=subprocess.STDOUT)
+        self.exit_code = None
+        self.stop_how = None
+        preexec = (_die_with_parent if die_with_parent and prctl is not None
+                   else None)
+        self.proc = subprocess.Popen(
+            cmd, env={**ros_env(domain), **(env or {})},
+            stdin=subprocess.DEVNULL, stdout=self._log,
+            stderr=subprocess.STDOUT, preexec_fn=preexec)
+
+    @property
+    def pid(self):
+        """Return the process id."""
+        return self.proc.pid
 
     def alive(self):
         """Return True while the process runs."""
         return self.proc.poll() is None
+
+    def tail(self, lines=15):
+        """Return the last ``lines`` lines of the log ('' if unreadable)."""
+        try:
+            if not self._log.closed:
+                self._log.flush()
+            with open(self.log_path, errors='replace') as fh:
+                return ''.join(fh.readlines()[-lines:])
+        except OSError:
+            return ''
 
     def log(self):
         """Return everything the process has written so far."""
@@ -64,12 +107,18 @@ class ChildProcess:
         the status is then the (negative) signal number.
         """
         if self.proc.poll() is None:
+            self.stop_how = 'SIGINT'
             self.proc.send_signal(signal.SIGINT)
             try:
                 self.proc.wait(timeout)
             except subprocess.TimeoutExpired:
+                self.stop_how = (f'SIGKILL (no exit {timeout:.0f} s after '
+                                 f'SIGINT)')
                 self.proc.kill()
                 self.proc.wait()
+        elif self.stop_how is None:
+            self.stop_how = 'had already exited'
         if not self._log.closed:
             self._log.close()
-        return self.proc.returncode
+        self.exit_code = self.proc.returncode
+        return self.exit_code

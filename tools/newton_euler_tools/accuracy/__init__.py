@@ -15,7 +15,7 @@
 """
 What accuracy costs in time: the measured accuracy/speed report.
 
-    python -m newton_euler_ros.accuracy [--quick] [--out DIR] [--no-peers]
+    python -m newton_euler_tools.accuracy [--quick] [--out DIR] [--no-peers]
 
 Every figure pairs a time (microseconds per call, measured in this run)
 with an error against ground truth: the same Newton-Euler recursion

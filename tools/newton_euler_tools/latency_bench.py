@@ -15,10 +15,10 @@
 """
 Measure latency: joint state in, torques out, through the real ROS graph.
 
-    python -m newton_euler_ros.latency_bench [--duration S] [--quick]
+    python -m newton_euler_tools.latency_bench [--duration S] [--quick]
                                              [--json PATH] [--rate HZ]
 
-Three phases, each in a ROS domain of its own, on loopback discovery:
+Four phases, each in a ROS domain of its own, on loopback discovery:
 
 1. **inverse_dynamics_node** (the node under test) is started as its own
    process (``inverse_dynamics_node --ros-args --params-file
@@ -31,8 +31,12 @@ Three phases, each in a ROS domain of its own, on loopback discovery:
    send time (this process's ``time.time_ns()``, the clock ROS's system
    time uses).  Every ``/inverse_dynamics_node/torques`` message is matched
    to its input by stamp: latency = receive time - header.stamp; dropped =
-   sent - received after a short drain.
-2. **echo_node** (:mod:`newton_euler_ros.nodes.echo_node`), the same
+   sent - received after a short drain.  The node spins its default
+   SingleThreadedExecutor; a second run of it with
+   ``NEWTON_EULER_EXECUTOR=events`` (the EventsExecutor) shows the
+   trade-off between the two executors: CPU and p99 against memory that
+   stays bounded under a flood.
+2. **echo_node** (:mod:`newton_euler_tools.echo_node`), the same
    message work with no dynamics, measured the same way: the floor.
 3. **self-loop**: the bench publishes to a subscription of its own, no
    other process: what the bench's own send and receive paths cost (no
@@ -76,7 +80,6 @@ and a MISS), 2 when it could not run.
 """
 import argparse
 import array
-import ctypes
 import gc
 import json
 import os
@@ -84,12 +87,13 @@ import platform
 import shlex
 import signal
 import struct
-import subprocess
 import sys
 import threading
 import time
 
 import numpy as np
+
+from .processes import ChildProcess, prctl as _prctl
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO_DIR = os.path.dirname(os.path.dirname(PACKAGE_DIR))
@@ -106,7 +110,7 @@ FALLBACK_LIMITS = ((-2.7925, 2.7925), (-0.7854, 3.9270), (-3.9270, 0.7854),
 
 TARGET_P99_US = 1000.0
 TARGET_OVERHEAD = 0.50          # (node - echo) / echo, on p50 and on p99
-DEFAULT_DOMAIN = 64             # phases use DOMAIN, DOMAIN + 1, DOMAIN + 2
+DEFAULT_DOMAIN = 64             # phases use DOMAIN .. DOMAIN + 3
 
 _CDR_LE = b'\x00\x01'
 _STAMP = struct.Struct('<iI')   # header.stamp.sec, .nanosec after the
@@ -145,22 +149,8 @@ def prepare_environment(build_dir):
     os.makedirs(os.environ['ROS_LOG_DIR'], exist_ok=True)
 
 
-def child_env(domain):
-    """
-    Return the parent's environment plus the ROS variables.
-
-    Only adds or overrides: LD_LIBRARY_PATH (set by the ROS wheels'
-    bootstrap) stays as it is.
-    """
-    env = dict(os.environ)
-    env['ROS_DOMAIN_ID'] = str(domain)
-    env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
-    env['PYTHONUNBUFFERED'] = '1'
-    return env
-
-
 def _params_file():
-    path = os.path.join(PACKAGE_DIR, os.pardir, 'config', 'params',
+    path = os.path.join(REPO_DIR, 'newton_euler_ros', 'config', 'params',
                         'puma560.yaml')
     if os.path.isfile(path):
         return os.path.normpath(path)
@@ -179,23 +169,10 @@ def node_command():
 
 
 def echo_command():
-    return [sys.executable, '-m', 'newton_euler_ros.nodes.echo_node']
+    return [sys.executable, '-m', 'newton_euler_tools.echo_node']
 
 
-_PR_SET_PDEATHSIG = 1
 _PR_SET_TIMERSLACK = 29
-try:
-    _prctl = ctypes.CDLL(None, use_errno=True).prctl
-    _prctl.argtypes = [ctypes.c_int, ctypes.c_ulong, ctypes.c_ulong,
-                       ctypes.c_ulong, ctypes.c_ulong]
-except (OSError, AttributeError):
-    _prctl = None
-
-
-def _die_with_parent():
-    # runs in the child between fork and exec: SIGKILL when we die
-    if _prctl is not None:
-        _prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
 
 
 def set_timer_slack(ns):
@@ -215,72 +192,8 @@ def _cpu_seconds(pid):
         return None
 
 
-class Child:
-    """A node process; its output goes to a log file."""
-
-    def __init__(self, cmd, domain, log_path):
-        self.cmd = cmd
-        self.log_path = log_path
-        os.makedirs(os.path.dirname(log_path), exist_ok=True)
-        self._log = open(log_path, 'w')
-        self.proc = subprocess.Popen(
-            cmd, env=child_env(domain), stdin=subprocess.DEVNULL,
-            stdout=self._log, stderr=subprocess.STDOUT,
-            preexec_fn=_die_with_parent if _prctl is not None else None)
-        self.exit_code = None
-        self.stop_how = None
-
-    @property
-    def pid(self):
-        return self.proc.pid
-
-    def alive(self):
-        return self.proc.poll() is None
-
-    def tail(self, lines=15):
-        try:
-            self._log.flush()
-            with open(self.log_path, errors='replace') as fh:
-                return ''.join(fh.readlines()[-lines:])
-        except OSError:
-            return ''
-
-    def stop(self, timeout=10.0):
-        """SIGINT; SIGKILL after ``timeout`` s.  Returns the exit code."""
-        if self.proc.poll() is None:
-            self.stop_how = 'SIGINT'
-            try:
-                self.proc.send_signal(signal.SIGINT)
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                self.stop_how = f'SIGKILL (no exit {timeout:.0f} s after ' \
-                                f'SIGINT)'
-                self.proc.kill()
-                self.proc.wait()
-        elif self.stop_how is None:
-            self.stop_how = 'had already exited'
-        if not self._log.closed:
-            self._log.close()
-        self.exit_code = self.proc.returncode
-        return self.exit_code
-
-
 # --------------------------------------------------------------------------
 # the bench's ROS side
-
-
-def make_executor(kind, context):
-    """Return (executor, name); 'events' falls back to 'single'."""
-    from rclpy.executors import SingleThreadedExecutor
-    if kind == 'events':
-        try:
-            from rclpy.experimental import EventsExecutor
-            return (EventsExecutor(context=context),
-                    'rclpy.experimental.EventsExecutor')
-        except Exception as exc:   # not in this rclpy, or fails to build
-            log(f'note: EventsExecutor unavailable ({exc}); using '
-                f'SingleThreadedExecutor')
-    return SingleThreadedExecutor(context=context), 'SingleThreadedExecutor'
 
 
 class BenchSide:
@@ -331,8 +244,11 @@ class BenchSide:
                     QoSProfile(depth=1000,
                                reliability=ReliabilityPolicy.RELIABLE),
                     raw=True)
-            self.executor, self.executor_name = make_executor(
-                executor_kind, self.context)
+            from newton_euler_ros.nodes.common import make_executor
+            self.executor = make_executor(
+                'events' if executor_kind == 'events' else 'single_threaded',
+                self.context)
+            self.executor_name = type(self.executor).__name__
             self.executor.add_node(self.node)
         except BaseException:
             self.close()
@@ -386,7 +302,7 @@ def raw_stamp_ns(raw):
 def joint_limits():
     try:
         import warnings
-        from .core import load_robot
+        from newton_euler_ros.core import load_robot
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')
             model = load_robot('puma560')
@@ -632,9 +548,10 @@ def summarize(send, received, rate):
     return out, lat_us
 
 
-def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir):
-    """Start ``cmd`` (None: self-loop), time it, stop it."""
+def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
+    """Start ``cmd`` (None: self-loop) with ``env`` added, time it, stop it."""
     log(f'\n--- {label}: domain {domain}'
+        + ''.join(f', {k}={v}' for k, v in (env or {}).items())
         + (f', {" ".join(shlex.quote(c) for c in cmd)}' if cmd else ''))
     result = {'label': label, 'domain': domain,
               'command': cmd, 'load_average_start': _loadavg()}
@@ -646,7 +563,9 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir):
     bench = None
     try:
         if cmd:
-            child = Child(cmd, domain, os.path.join(logs_dir, f'{key}.log'))
+            child = ChildProcess(cmd, domain,
+                                 os.path.join(logs_dir, f'{key}.log'),
+                                 env=env, die_with_parent=True)
             result['log'] = child.log_path
         command_topic = (sub_topic.rsplit('/', 1)[0] + '/torque_command'
                          if cmd and args.also_command else None)
@@ -773,7 +692,7 @@ def verdicts(node, echo):
 
 
 def print_table(phases):
-    head = (f'{"":24s}{"p50":>7s}{"p99":>8s}{"p99.9":>8s}{"max":>8s}'
+    head = (f'{"":30s}{"p50":>7s}{"p99":>8s}{"p99.9":>8s}{"max":>8s}'
             f'{"sent":>8s}{"recv":>8s}{"drop":>6s}{"rate Hz":>9s}'
             f'{"cpu%":>6s}')
     log('latency = receive time - header.stamp, in us')
@@ -782,7 +701,7 @@ def print_table(phases):
     for r in phases:
         L = r['latency_us']
         cpu = r.get('node_cpu_percent')
-        log(f'{r["label"]:24s}{L["p50"]:7.0f}{L["p99"]:8.0f}'
+        log(f'{r["label"]:30s}{L["p50"]:7.0f}{L["p99"]:8.0f}'
             f'{L["p99.9"]:8.0f}{L["max"]:8.0f}{r["sent"]:8d}'
             f'{r["received"]:8d}{r["dropped"]:6d}{r["send_rate_hz"]:9.1f}'
             + (f'{cpu:6.0f}' if cpu is not None else f'{"-":>6s}'))
@@ -800,7 +719,7 @@ def print_table(phases):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_ros.latency_bench',
+        prog='python -m newton_euler_tools.latency_bench',
         description='Latency of inverse_dynamics_node (joint state in, '
                     'torques out) at 1 kHz, against an echo node floor.')
     parser.add_argument('--duration', type=float, default=10.0,
@@ -843,7 +762,7 @@ def main(argv=None):
     parser.add_argument('--no-timer-slack', action='store_true',
                         help="keep the sending thread's default timer slack")
     parser.add_argument('--skip', action='append', default=[],
-                        choices=('node', 'echo', 'loop'),
+                        choices=('node', 'events', 'echo', 'loop'),
                         help='leave a phase out (repeatable)')
     parser.add_argument('--also-command', action='store_true',
                         help='also subscribe ~/torque_command (counted, not '
@@ -854,7 +773,7 @@ def main(argv=None):
                              'script with the puma560 params)')
     parser.add_argument('--echo-cmd', metavar='CMD',
                         help='command of the floor node (default: python -m '
-                             'newton_euler_ros.nodes.echo_node)')
+                             'newton_euler_tools.echo_node)')
     parser.add_argument('--strict', action='store_true',
                         help='exit code 1 when a target is missed')
     args = parser.parse_args(argv)
@@ -862,8 +781,8 @@ def main(argv=None):
         args.duration = 2.0
     if args.duration <= 0 or args.rate <= 0:
         parser.error('--duration and --rate must be > 0')
-    if not 0 <= args.domain <= 230:
-        parser.error('--domain must be in 0..230')
+    if not 0 <= args.domain <= 229:
+        parser.error('--domain must be in 0..229')
 
     build_dir = _default_dirs()
     prepare_environment(build_dir)
@@ -895,21 +814,24 @@ def main(argv=None):
         f'{args.switch_us:g} us during timing')
 
     phases = []
-    plan = [('node', f'{NODE_NAME}', args.domain,
-             shlex.split(args.node_cmd) if args.node_cmd else node_command(),
-             NODE_TOPIC),
+    node_cmd = (shlex.split(args.node_cmd) if args.node_cmd
+                else node_command())
+    plan = [('node', f'{NODE_NAME}', args.domain, node_cmd, NODE_TOPIC, None),
+            ('events', f'{NODE_NAME}, events', args.domain + 3, node_cmd,
+             NODE_TOPIC, {'NEWTON_EULER_EXECUTOR': 'events'}),
             ('echo', 'echo_node (floor)', args.domain + 1,
              shlex.split(args.echo_cmd) if args.echo_cmd else echo_command(),
-             ECHO_TOPIC),
-            ('loop', 'bench self-loop', args.domain + 2, None, LOOP_TOPIC)]
+             ECHO_TOPIC, None),
+            ('loop', 'bench self-loop', args.domain + 2, None, LOOP_TOPIC,
+             None)]
     by_key = {}
     t_start = time.monotonic()
     try:
-        for key, label, domain, cmd, topic in plan:
+        for key, label, domain, cmd, topic, env in plan:
             if key in args.skip:
                 continue
             result, _ = run_phase(key, label, domain, cmd, topic, args,
-                                  logs_dir)
+                                  logs_dir, env)
             result['key'] = key
             phases.append(result)
             by_key[key] = result
@@ -946,6 +868,17 @@ def main(argv=None):
                      else f'{t["value"]:+.0f}%')
             log(f'  {name:40s} {"PASS" if t["pass"] else "MISS"}  ({value})')
             missed |= not t['pass']
+        if 'events' in by_key:
+            ev, nd = by_key['events'], by_key['node']
+            log(f'executor trade-off: the default SingleThreadedExecutor p50 '
+                f'{nd["latency_us"]["p50"]:.0f} / p99 '
+                f'{nd["latency_us"]["p99"]:.0f} us at '
+                f'{nd.get("node_cpu_percent", float("nan")):.0f}% CPU; '
+                f'NEWTON_EULER_EXECUTOR=events p50 '
+                f'{ev["latency_us"]["p50"]:.0f} / p99 '
+                f'{ev["latency_us"]["p99"]:.0f} us at '
+                f'{ev.get("node_cpu_percent", float("nan")):.0f}% CPU, but '
+                f'memory unbounded under a flood (test_load_node.py)')
         codes = ', '.join(f'{r["label"]} {r["exit_code"]}'
                           for r in phases if 'exit_code' in r)
         log(f'child exit codes after SIGINT: {codes}')

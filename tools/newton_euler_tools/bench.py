@@ -17,25 +17,28 @@ Benchmark our Newton-Euler dynamics and check the performance targets.
 
 The peers are Pinocchio, Robotics Toolbox and a naive numpy recursion.
 
-    python -m newton_euler_ros.bench [--quick] [--json PATH]
+    python -m newton_euler_tools.bench [--quick] [--json PATH]
                                      [--robot NAME ...] [--seed N]
 
 For each robot (default: the bundled ``puma560`` and ``panda``) it
 
-1. checks that the peer models built by :mod:`newton_euler_ros.peers` give
+1. checks that the peer models built by :mod:`newton_euler_tools.peers` give
    the same tau, D, C and g as ours at random states (a timing of a wrongly
    built peer model is worthless, so a peer that disagrees is marked
    INVALID and no verdict is drawn from it);
 2. times one call from Python of each operation, warm (JIT compilation
    excluded): ``time.perf_counter_ns`` around a loop of N calls, repeated R
    times, reporting the minimum and the median per call;
-3. times our batched inverse dynamics over 10 000 random states (per state);
+3. times our batched tau, D, C, g and forward dynamics over 10 000 random
+   states (per state);
 4. measures where our time goes: numba dispatch of a do-nothing function
    with the same arguments, the public API against the raw kernel, and
    the first-call compile / cache-load time in a fresh interpreter;
-5. prints the table and the targets (single-state tau, D, C, g each within
-   5x of Pinocchio; batched <= 2 us per state) with PASS/MISS computed from
-   the numbers measured in this run.
+5. prints the table and the targets with PASS/MISS computed from the
+   numbers measured in this run: tau, D, C and g each <= 1.25x Pinocchio's
+   Python call, forward dynamics <= 1.5x ``pin.aba``; batched tau <= 0.4x
+   and batched D, C, g and forward dynamics <= 0.5x a Python loop of the
+   matching Pinocchio function, per state.
 
 Peers are optional: a missing library is reported and skipped.
 """
@@ -51,28 +54,42 @@ import time
 import timeit
 import warnings
 
+import newton_euler_ros
+from newton_euler_ros.core import _kernels as K
+from newton_euler_ros.core import (coriolis_matrix, coriolis_matrix_batch,
+                                   forward_dynamics, forward_dynamics_batch,
+                                   gravity_torques, gravity_torques_batch,
+                                   inverse_dynamics, inverse_dynamics_batch,
+                                   load_robot, mass_matrix, mass_matrix_batch,
+                                   NewtonEulerError, Workspace)
+from newton_euler_ros.core import dynamics as _dynamics
+from newton_euler_ros.core.model import REVOLUTE, STANDARD
 import numpy as np
 
 from . import peers
-from .core import _kernels as K
-from .core import (coriolis_matrix, gravity_torques, inverse_dynamics,
-                   inverse_dynamics_batch, load_robot, mass_matrix,
-                   NewtonEulerError, Workspace)
-from .core import dynamics as _dynamics
-from .core.model import REVOLUTE, STANDARD
 
 DEFAULT_ROBOTS = ('puma560', 'panda')
 BATCH_STATES = 10_000
-PIN_LOOP_STATES = 1_000      # states in the Python loop over pin.rnea
-TARGET_RATIO = 5.0           # ours / Pinocchio, single-state tau, D, C, g
-TARGET_BATCH_US = 2.0        # batched inverse dynamics, us per state
-OPS = ('tau', 'D', 'C', 'g', 'batch')
+PIN_LOOP_STATES = 1_000      # states in the Python loops over Pinocchio
+SINGLE = ('tau', 'D', 'C', 'g', 'FD')
+BATCHES = ('batch', 'batch_D', 'batch_C', 'batch_g', 'batch_FD')
+OPS = SINGLE + BATCHES
+# targets, ours / Pinocchio's Python call (batches: per state, against a
+# Python loop of the matching Pinocchio function)
+TARGETS = {'tau': 1.25, 'D': 1.25, 'C': 1.25, 'g': 1.25, 'FD': 1.5,
+           'batch': 0.4, 'batch_D': 0.5, 'batch_C': 0.5, 'batch_g': 0.5,
+           'batch_FD': 0.5}
 OP_LABELS = {
     'tau': 'tau = ID(q,qd,qdd)',
     'D': 'D(q) mass matrix',
     'C': 'C(q,qd) Coriolis',
     'g': 'g(q) gravity',
+    'FD': 'FD qdd (ABA)',
     'batch': 'batch ID, per state',
+    'batch_D': 'batch D, per state',
+    'batch_C': 'batch C, per state',
+    'batch_g': 'batch g, per state',
+    'batch_FD': 'batch FD, per state',
 }
 
 
@@ -235,6 +252,7 @@ def naive_mass_matrix(model, q):
 
 
 def _dispatch_probes():
+    """Do-nothing njit functions with the entry points' argument lists."""
     from numba import njit
 
     @njit(cache=False)
@@ -246,19 +264,23 @@ def _dispatch_probes():
         return -1
 
     @njit(cache=False)
-    def noop_id(links, frames, q, qd, qdd, wrench, gravity_on, velocity_on,
-                wrench_mode, ws, tau):
+    def noop4(P, q, ws, out):
         return -1
 
     @njit(cache=False)
-    def noop_mm(links, frames, q, ws, D):
-        return None
+    def noop_tau(P, q, qd, qdd, wrench, flags, ws, tau):
+        return -1
 
     @njit(cache=False)
-    def noop_cm(links, frames, q, qd, ws, scratch, C):
-        return None
+    def noop_c(P, q, qd, composite, ws, cw, scratch, C):
+        return -1
 
-    return noop0, noop1, noop_id, noop_mm, noop_cm
+    @njit(cache=False)
+    def noop_fd(P, q, qd, tau, wrench, flags, ws, aw, qdd):
+        return -1
+
+    return {'noop0': noop0, 'noop1': noop1, 'noop4': noop4,
+            'noop_tau': noop_tau, 'noop_c': noop_c, 'noop_fd': noop_fd}
 
 
 # --------------------------------------------------------------------------
@@ -293,13 +315,14 @@ def _tolerance(ref):
 
 
 def ours_reference(model, states):
-    """tau, D, C, g from our public API at each (q, qd, qdd)."""
+    """tau, D, C, g and FD (qdd as the torque) at each (q, qd, qdd)."""
     out = []
     for q, qd, qdd in states:
         out.append({'tau': inverse_dynamics(model, q, qd, qdd),
                     'D': mass_matrix(model, q),
                     'C': coriolis_matrix(model, q, qd),
                     'g': gravity_torques(model, q),
+                    'FD': forward_dynamics(model, q, qd, qdd),
                     'Cqd': inverse_dynamics(model, q, qd, None,
                                             gravity=False)})
     return out
@@ -364,50 +387,57 @@ def bench_robot(name, timer, rng, log):
     rtb_ns = _setup_rtb(model, check_states, ref, result, log)
 
     # ---- our public API and raw kernels ----
+    W = np.zeros((m, 6))
     ns = {'model': model, 'q': q, 'qd': qd, 'qdd': qdd, 'ws': ws,
           'tau': tau, 'D': D, 'C': C, 'g': g, 'Q': Q, 'QD': QD, 'QDD': QDD,
-          'TAU': TAU, 'W': W, 'K': K,
-          'links': model.links_array, 'frames': model.frames_array,
+          'TAU': TAU, 'W': W, 'K': K, 'P': model.packed,
+          'DD': np.empty((m, n, n)),
           'inverse_dynamics': inverse_dynamics, 'mass_matrix': mass_matrix,
           'coriolis_matrix': coriolis_matrix,
           'gravity_torques': gravity_torques,
+          'forward_dynamics': forward_dynamics,
           'inverse_dynamics_batch': inverse_dynamics_batch,
+          'mass_matrix_batch': mass_matrix_batch,
+          'coriolis_matrix_batch': coriolis_matrix_batch,
+          'gravity_torques_batch': gravity_torques_batch,
+          'forward_dynamics_batch': forward_dynamics_batch,
           'naive_rnea': naive_rnea, 'naive_mass_matrix': naive_mass_matrix,
           'zeros': np.zeros(n), 'zero_w': np.zeros(6), 'wsa': ws.ws,
-          'scratch': ws.scratch, '_vector': _dynamics._vector, 'n': n,
-          'WN': K.WRENCH_NONE}
+          'scratch': ws.scratch, 'cw': ws.cw, 'aw': ws.aw,
+          'status': ws.status, '_vector': _dynamics._vector, 'n': n}
     stmts = {
         'tau': 'inverse_dynamics(model, q, qd, qdd, ws=ws, out=tau)',
         'D': 'mass_matrix(model, q, ws=ws, out=D)',
         'C': 'coriolis_matrix(model, q, qd, ws=ws, out=C)',
         'g': 'gravity_torques(model, q, ws=ws, out=g)',
+        'FD': 'forward_dynamics(model, q, qd, qdd, ws=ws, out=g)',
     }
     raw = {
-        'tau': 'K.inverse_dynamics(links, frames, q, qd, qdd, zero_w, True, '
-               'True, WN, wsa, tau)',
-        'D': 'K.mass_matrix_crba(links, frames, q, wsa, D)',
-        'C': 'K.coriolis_matrix(links, frames, q, qd, wsa, scratch, C)',
-        'g': 'K.inverse_dynamics(links, frames, q, zeros, zeros, zero_w, '
-             'True, False, WN, wsa, g)',
+        'tau': 'K.run_inverse_dynamics(P, q, qd, qdd, zero_w, 3, wsa, tau)',
+        'D': 'K.run_mass_matrix_crba(P, q, wsa, D)',
+        'C': 'K.run_coriolis_matrix(P, q, qd, True, wsa, cw, scratch, C)',
+        'g': 'K.run_gravity_torques(P, q, wsa, g)',
+        'FD': 'K.run_forward_dynamics(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
     }
-    noop0, noop1, noop_id, noop_mm, noop_cm = _dispatch_probes()
-    ns.update(noop0=noop0, noop1=noop1, noop_id=noop_id, noop_mm=noop_mm,
-              noop_cm=noop_cm, np=np)
+    probes_fns = _dispatch_probes()
+    ns.update(probes_fns, np=np)
     naive = {'tau': 'naive_rnea(model, q, qd, qdd)',
              'D': 'naive_mass_matrix(model, q)',
              'g': 'naive_rnea(model, q, zeros, zeros)'}
     pin = {'tau': 'rnea(pm, pd, q, qd, qdd)', 'D': 'crba(pm, pd, q)',
            'C': 'computeCoriolisMatrix(pm, pd, q, qd)',
-           'g': 'computeGeneralizedGravity(pm, pd, q)'}
+           'g': 'computeGeneralizedGravity(pm, pd, q)',
+           'FD': 'aba(pm, pd, q, qd, qdd)'}
     rtb = {'tau': 'robot.rne(q, qd, qdd)', 'D': 'robot.inertia(q)',
-           'C': 'robot.coriolis(q, qd)', 'g': 'robot.gravload(q)'}
+           'C': 'robot.coriolis(q, qd)', 'g': 'robot.gravload(q)',
+           'FD': 'robot.accel(q, qd, qdd)'}
     for extra in (pin_ns, rtb_ns):
         if extra is not None:
             extra.update(q=q, qd=qd, qdd=qdd, Q=Q, QD=QD, QDD=QDD)
 
     # one group per operation: ours, our raw kernel and every peer, their
     # repeats interleaved
-    for op in ('tau', 'D', 'C', 'g'):
+    for op in SINGLE:
         entries = {('ours', op): (stmts[op], ns, None, 1),
                    ('ours_raw', op): (raw[op], ns, None, 1)}
         if pin_ns is not None:
@@ -417,30 +447,46 @@ def bench_robot(name, timer, rng, log):
         if op in naive:
             entries[('naive', op)] = (naive[op], ns, None, 1)
         T.update(timer.group(entries))
-    entries = {
-        ('ours', 'batch'): ('inverse_dynamics_batch(model, Q, QD, QDD, '
-                            'ws=ws, out=TAU)', ns, 1, m),
-        ('ours_raw', 'batch'): ('K.inverse_dynamics_batch(links, frames, Q, '
-                                'QD, QDD, W, True, True, WN, wsa, TAU)', ns,
-                                1, m)}
-    if pin_ns is not None:
-        entries[('pin', 'batch')] = (
-            f'for i in range({PIN_LOOP_STATES}): '
-            f'rnea(pm, pd, Q[i], QD[i], QDD[i])', pin_ns, 1, PIN_LOOP_STATES)
-    if rtb_ns is not None:
-        entries[('rtb', 'batch')] = ('robot.rne(Q, QD, QDD)', rtb_ns, 1, m)
-    T.update(timer.group(entries))
+    batch = {
+        'batch': ('inverse_dynamics_batch(model, Q, QD, QDD, ws=ws, '
+                  'out=TAU)', 'K.run_inverse_dynamics_batch(P, Q, QD, QDD, '
+                  'W, 3, wsa, TAU, status)', 'rnea(pm, pd, Q[i], QD[i], '
+                  'QDD[i])'),
+        'batch_D': ('mass_matrix_batch(model, Q, ws=ws, out=DD)',
+                    'K.run_mass_matrix_batch(P, Q, wsa, DD, status)',
+                    'crba(pm, pd, Q[i])'),
+        'batch_C': ('coriolis_matrix_batch(model, Q, QD, ws=ws, out=DD)',
+                    'K.run_coriolis_matrix_batch(P, Q, QD, wsa, cw, DD, '
+                    'status)', 'computeCoriolisMatrix(pm, pd, Q[i], QD[i])'),
+        'batch_g': ('gravity_torques_batch(model, Q, ws=ws, out=TAU)',
+                    'K.run_gravity_torques_batch(P, Q, wsa, TAU, status)',
+                    'computeGeneralizedGravity(pm, pd, Q[i])'),
+        'batch_FD': ('forward_dynamics_batch(model, Q, QD, QDD, ws=ws, '
+                     'out=TAU)', 'K.run_forward_dynamics_batch(P, Q, QD, '
+                     'QDD, W, 3, wsa, aw, TAU, status)',
+                     'aba(pm, pd, Q[i], QD[i], QDD[i])'),
+    }
+    for op, (public, kernel, pin_call) in batch.items():
+        entries = {('ours', op): (public, ns, 1, m),
+                   ('ours_raw', op): (kernel, ns, 1, m)}
+        if pin_ns is not None:
+            entries[('pin', op)] = (
+                f'for i in range({PIN_LOOP_STATES}): {pin_call}', pin_ns, 1,
+                PIN_LOOP_STATES)
+        if rtb_ns is not None and op == 'batch':
+            entries[('rtb', op)] = ('robot.rne(Q, QD, QDD)', rtb_ns, 1, m)
+        T.update(timer.group(entries))
 
     # ---- where the time goes ----
     probes = {
         'empty_loop': 'pass',
         'njit_0_args': 'noop0()',
         'njit_1_array': 'noop1(q)',
-        'njit_id_args': 'noop_id(links, frames, q, qd, qdd, zero_w, True, '
-                        'True, WN, wsa, tau)',
-        'njit_D_args': 'noop_mm(links, frames, q, wsa, D)',
-        'njit_C_args': 'noop_cm(links, frames, q, qd, wsa, scratch, C)',
-        'check_finite_kernel': 'K.check_finite(q, qd, qdd, zero_w)',
+        'njit_tau_args': 'noop_tau(P, q, qd, qdd, zero_w, 3, wsa, tau)',
+        'njit_D_args': 'noop4(P, q, wsa, D)',
+        'njit_C_args': 'noop_c(P, q, qd, True, wsa, cw, scratch, C)',
+        'njit_g_args': 'noop4(P, q, wsa, g)',
+        'njit_FD_args': 'noop_fd(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
         '_vector_one_arg': "_vector('q', q, n)",
         'np_empty_n': 'np.empty(n)',
     }
@@ -479,10 +525,11 @@ def _setup_pinocchio(model, states, ref, result, log):
             'g': np.array(pin.computeGeneralizedGravity(pm, pd, q)),
             'C': Cp,
             'Cqd': Cp @ qd,
+            'FD': np.array(pin.aba(pm, pd, q, qd, qdd)),
         })
     diffs, ok = compare(ref, got)
     result['correctness']['pin'] = diffs
-    valid = ok['tau'] and ok['D'] and ok['g'] and ok['Cqd']
+    valid = ok['tau'] and ok['D'] and ok['g'] and ok['Cqd'] and ok['FD']
     result['valid']['pin'] = valid
     result['valid']['pin_C_is_christoffel'] = ok['C']
     log('  Pinocchio   : ' + _fmt_diffs(diffs, ok))
@@ -500,7 +547,8 @@ def _setup_pinocchio(model, states, ref, result, log):
             'timings are marked INVALID')
     return {'pm': pm, 'pd': pd, 'rnea': pin.rnea, 'crba': pin.crba,
             'computeCoriolisMatrix': pin.computeCoriolisMatrix,
-            'computeGeneralizedGravity': pin.computeGeneralizedGravity}
+            'computeGeneralizedGravity': pin.computeGeneralizedGravity,
+            'aba': pin.aba}
 
 
 def _setup_rtb(model, states, ref, result, log):
@@ -521,7 +569,8 @@ def _setup_rtb(model, states, ref, result, log):
             got.append({'tau': np.array(robot.rne(q, qd, qdd)),
                         'D': np.array(robot.inertia(q)),
                         'C': C, 'g': np.array(robot.gravload(q)),
-                        'Cqd': C @ qd})
+                        'Cqd': C @ qd,
+                        'FD': np.array(robot.accel(q, qd, qdd))})
     c_ext = bool(getattr(frne, '_C_AVAILABLE', False)) and \
         robot._frne is not None
     diffs, ok = compare(ref, got)
@@ -542,31 +591,27 @@ def _setup_rtb(model, states, ref, result, log):
 
 
 def verdicts(result):
+    """PASS/MISS per operation: ours / Pinocchio against ``TARGETS``."""
     T = result['timings']
     out = {}
-    for op in ('tau', 'D', 'C', 'g'):
+    for op in OPS:
+        limit = TARGETS[op]
+        target = (f'<= {limit:g}x Pinocchio' if op in SINGLE
+                  else f'<= {limit:g}x pin loop')
         ours, pin = T.get(('ours', op)), T.get(('pin', op))
         if pin is None:
-            out[op] = {'target': f'<= {TARGET_RATIO:g}x Pinocchio',
-                       'verdict': 'n/a (no Pinocchio)'}
+            out[op] = {'target': target, 'verdict': 'n/a (no Pinocchio)'}
             continue
         ratio = ours['min_us'] / pin['min_us']
         ratio_med = ours['median_us'] / pin['median_us']
         if not result['valid'].get('pin'):
             verdict = 'INVALID peer'
         else:
-            verdict = 'PASS' if ratio <= TARGET_RATIO else 'MISS'
-        out[op] = {'target': f'<= {TARGET_RATIO:g}x Pinocchio',
-                   'ratio_min': ratio, 'ratio_median': ratio_med,
-                   'verdict': verdict,
-                   'over_by': ratio / TARGET_RATIO,
-                   'needed_us': pin['min_us'] * TARGET_RATIO}
-    b = T[('ours', 'batch')]['min_us']
-    out['batch'] = {'target': f'<= {TARGET_BATCH_US:g} us/state',
-                    'us_per_state': b,
-                    'verdict': 'PASS' if b <= TARGET_BATCH_US else 'MISS',
-                    'over_by': b / TARGET_BATCH_US,
-                    'needed_us': TARGET_BATCH_US}
+            verdict = 'PASS' if ratio <= limit else 'MISS'
+        out[op] = {'target': target, 'ratio_min': ratio,
+                   'ratio_median': ratio_med, 'verdict': verdict,
+                   'over_by': ratio / limit,
+                   'needed_us': pin['min_us'] * limit}
     return out
 
 
@@ -598,76 +643,57 @@ def print_table(result, timer, log):
     log('-' * len(head))
     for op in OPS:
         v = V[op]
-        if op == 'batch':
-            ratio = '-'
-            if ('pin', op) in T:
-                ours_b, pin_b = T[('ours', op)], T[('pin', op)]
-                ratio = f'{ours_b["min_us"] / pin_b["min_us"]:.2f}'
-        else:
-            ratio = f'{v["ratio_min"]:.2f}' if 'ratio_min' in v else '-'
+        ratio = f'{v["ratio_min"]:.2f}' if 'ratio_min' in v else '-'
         log(f'{OP_LABELS[op]:<22}{_cell(T.get(("ours", op))):>16}'
             f'{_cell(T.get(("pin", op)), valid.get("pin")):>16}{ratio:>10}'
             f'  {v["target"]:<22}{v["verdict"]:<13}'
             f'{_cell(T.get(("rtb", op)), valid.get("rtb")):>18}'
             f'{_cell(T.get(("naive", op)), valid.get("naive")):>18}')
-    log(f'  batch: ours = one inverse_dynamics_batch call over '
-        f'{BATCH_STATES} states; Pinocchio = Python loop of pin.rnea over '
-        f'{PIN_LOOP_STATES} states (it has no batched rnea); RTB = one '
-        f'rne call with ({BATCH_STATES}, n) arrays.')
+    log(f'  batch rows: ours = one batched call over {BATCH_STATES} states; '
+        f'Pinocchio = a Python loop of the matching function over '
+        f'{PIN_LOOP_STATES} states (it has no batched calls); RTB = one rne '
+        f'call with ({BATCH_STATES}, n) arrays.')
     log('  D: Pinocchio crba fills only the upper triangle; ours and RTB '
         'return the full matrix.  RTB inertia = n rne calls, coriolis = '
-        'n(n+1)/2 rne calls from Python.')
+        'n(n+1)/2 rne calls from Python, accel = a solve with its inertia.')
 
 
 def print_breakdown(result, log):
     T = result['timings']
-    n = result['dof']
     P = {k[1]: v['min_us'] for k, v in T.items() if k[0] == 'probe'}
     log(f'\n{result["robot"]}: where our time goes (min us per call)')
     log(f'  timing loop, empty statement: {P["empty_loop"]:.3f}')
     log(f'  numba dispatch of a do-nothing njit function: no args '
-        f'{P["njit_0_args"]:.3f}, one array {P["njit_1_array"]:.3f}, '
-        f'the 11 args of K.inverse_dynamics {P["njit_id_args"]:.3f}, '
-        f'the 6 of K.mass_matrix {P["njit_D_args"]:.3f}, '
-        f'the 7 of K.coriolis_matrix {P["njit_C_args"]:.3f}')
+        f'{P["njit_0_args"]:.3f}, one array {P["njit_1_array"]:.3f}; with '
+        f'the entry points\' arguments: tau (8) {P["njit_tau_args"]:.3f}, '
+        f'D and g (4) {P["njit_D_args"]:.3f}, C (8) '
+        f'{P["njit_C_args"]:.3f}, FD (9) {P["njit_FD_args"]:.3f}')
     log(f'  Python pieces: _vector() of one ready array '
-        f'{P["_vector_one_arg"]:.3f}; np.empty(n) {P["np_empty_n"]:.3f}; '
-        f'K.check_finite (4 arrays, a separate dispatch) '
-        f'{P["check_finite_kernel"]:.3f}')
-    dispatch = {'tau': P['njit_id_args'], 'g': P['njit_id_args'],
-                'D': P['njit_D_args'], 'C': P['njit_C_args']}
-    extra = {'D': P['check_finite_kernel'], 'C': P['check_finite_kernel']}
+        f'{P["_vector_one_arg"]:.3f} (the fallback only); np.empty(n) '
+        f'{P["np_empty_n"]:.3f}')
     log(f'  {"op":<6}{"public":>9}{"raw kernel":>12}{"wrapper":>10}'
-        f'{"dispatch":>10}{"compute":>10}  notes')
+        f'{"dispatch":>10}{"compute":>10}')
     result['breakdown'] = {}
-    batch_compute = T[('ours_raw', 'batch')]['min_us']
-    for op in ('tau', 'D', 'C', 'g'):
+    for op in SINGLE:
         pub = T[('ours', op)]['min_us']
         raw = T[('ours_raw', op)]['min_us']
-        disp = dispatch[op]
+        disp = P[f'njit_{op}_args' if op != 'g' else 'njit_D_args']
         compute = max(raw - disp, 0.0)
         wrapper = pub - raw
-        note = ''
-        if op in ('D', 'C'):
-            note = (f'{n} recursions, {compute / n:.3f} each; wrapper '
-                    f'includes a second dispatch (check_finite) '
-                    f'~{extra[op]:.2f}')
-        elif op == 'tau':
-            note = (f'kernel alone per state in the batch loop '
-                    f'{batch_compute:.3f}')
         log(f'  {op:<6}{pub:>9.3f}{raw:>12.3f}{wrapper:>10.3f}{disp:>10.3f}'
-            f'{compute:>10.3f}  {note}')
+            f'{compute:>10.3f}')
         result['breakdown'][op] = {
             'public_us': pub, 'raw_kernel_us': raw, 'wrapper_us': wrapper,
             'dispatch_us': disp, 'compute_us': compute,
             'share_wrapper': wrapper / pub, 'share_dispatch': disp / pub,
             'share_compute': compute / pub}
-    bp = T[('ours', 'batch')]['min_us']
-    br = T[('ours_raw', 'batch')]['min_us']
-    log(f'  batch per state: public {bp:.3f}, raw kernel {br:.3f}, '
-        f'validation/copies in Python {bp - br:.3f}')
-    result['breakdown']['batch'] = {'public_us': bp, 'raw_kernel_us': br,
-                                    'wrapper_us': bp - br}
+    for op in BATCHES:
+        bp = T[('ours', op)]['min_us']
+        br = T[('ours_raw', op)]['min_us']
+        log(f'  {op} per state: public {bp:.3f}, raw kernel {br:.3f}, '
+            f'validation/copies in Python {bp - br:.3f}')
+        result['breakdown'][op] = {'public_us': bp, 'raw_kernel_us': br,
+                                   'wrapper_us': bp - br}
 
 
 def print_misses(result, log):
@@ -684,46 +710,23 @@ def print_misses(result, log):
             + (f'; not checked: {", ".join(other)}' if other else ''))
         return
     log(f'\n{result["robot"]}: targets missed')
-    n = result['dof']
     for op in misses:
         v = V[op]
         b = B[op]
         pub = b['public_us']
-        if op == 'batch':
-            log(f'  batch: {v["us_per_state"]:.3f} us/state vs '
-                f'<= {TARGET_BATCH_US:g}: {v["over_by"]:.2f}x over; kernel '
-                f'{b["raw_kernel_us"]:.3f}, Python validation '
-                f'{b["wrapper_us"]:.3f} per state')
-            continue
         pin = T[('pin', op)]['min_us']
         log(f'  {op}: {pub:.3f} us vs Pinocchio {pin:.3f} = '
-            f'{v["ratio_min"]:.2f}x (target {TARGET_RATIO:g}x, '
-            f'{v["over_by"]:.2f}x over); needs <= {v["needed_us"]:.3f} us, '
-            f'i.e. {pub - v["needed_us"]:.3f} us less')
+            f'{v["ratio_min"]:.2f}x (target {TARGETS[op]:g}x); needs <= '
+            f'{v["needed_us"]:.3f} us, i.e. {pub - v["needed_us"]:.3f} us '
+            f'less')
+        if op in BATCHES:
+            continue
         parts = sorted((('Python wrapper', b['wrapper_us']),
                         ('numba dispatch', b['dispatch_us']),
                         ('kernel compute', b['compute_us'])),
                        key=lambda kv: -kv[1])
         log('     split: ' + ', '.join(
             f'{k} {x:.3f} ({100 * x / pub:.0f}%)' for k, x in parts))
-        top = parts[0][0]
-        if top == 'kernel compute' and op in ('D', 'C'):
-            log(f'     dominant: the {n} full recursions '
-                f'({b["compute_us"] / n:.3f} us each) against one O(n) '
-                f'pass in Pinocchio; even with zero overhead the kernel '
-                f'alone is {b["compute_us"] / pin:.2f}x Pinocchio')
-        elif top == 'kernel compute':
-            log(f'     dominant: the kernel itself; alone it is '
-                f'{b["compute_us"] / pin:.2f}x Pinocchio')
-        elif top == 'numba dispatch':
-            log(f'     dominant: numba dispatch (type-checking and unboxing '
-                f'the arguments); that alone is {b["dispatch_us"] / pin:.2f}x '
-                f"Pinocchio's whole call")
-        else:
-            log(f'     dominant: Python work in the public wrapper '
-                f'(argument conversion/validation, default workspace); '
-                f'that alone is {b["wrapper_us"] / pin:.2f}x Pinocchio\'s '
-                f'whole call')
 
 
 # --------------------------------------------------------------------------
@@ -766,7 +769,9 @@ print(json.dumps({'import_s': t1 - t0, 'load_robot_s': t2 - t1,
 def first_call_times(robot, cache_dir=None):
     """Run ``_FIRST_CALL`` in a fresh interpreter; dict of seconds."""
     env = dict(os.environ)
-    pkg_root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    # the source tree of newton_euler_ros (not of these tools) goes first
+    pkg_root = os.path.dirname(os.path.dirname(
+        os.path.abspath(newton_euler_ros.__file__)))
     env['PYTHONPATH'] = os.pathsep.join(
         [pkg_root] + [p for p in env.get('PYTHONPATH', '').split(os.pathsep)
                       if p])
@@ -819,7 +824,7 @@ def _jsonable(result):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_ros.bench',
+        prog='python -m newton_euler_tools.bench',
         description='Time our dynamics against Pinocchio, Robotics Toolbox '
                     'and naive numpy, and check the performance targets.')
     parser.add_argument('--quick', action='store_true',
@@ -894,8 +899,7 @@ def main(argv=None):
         payload = {'versions': versions, 'quick': args.quick,
                    'loadavg_start': load_start, 'loadavg_end': load_end,
                    'seed': args.seed, 'batch_states': BATCH_STATES,
-                   'targets': {'ratio_vs_pinocchio': TARGET_RATIO,
-                               'batch_us_per_state': TARGET_BATCH_US},
+                   'targets': TARGETS,
                    'first_call': first, 'elapsed_s': elapsed,
                    'robots': [_jsonable(r) for r in results]}
         with open(args.json, 'w') as fh:

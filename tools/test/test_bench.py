@@ -1,0 +1,23 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The benchmarks run (smoke tests: their figures are not judged here)."""
+
+
+def test_effect_benchmark_runs(capsys):
+    """Smoke test: the effect benchmark runs (its figures are not judged)."""
+    from newton_euler_tools import bench_effects
+    assert bench_effects.main(['puma_payload_press', '--quick']) == 0
+    out = capsys.readouterr().out
+    assert 'without friction' in out and 'none (D qdd only)' in out
