@@ -87,15 +87,28 @@ class Probe:
     def spin_for(self, seconds):
         self.spin_until(lambda: False, seconds)
 
-    def call(self, srv_type, name, request, timeout=10.0):
+    def call(self, srv_type, name, request, timeout=10.0, resend=5.0):
+        """
+        Call ``name`` and return the response, or raise TimeoutError.
+
+        A request that gets no answer within ``resend`` seconds is sent
+        again: DDS can drop the first response of a fresh client when the
+        server's response writer has not yet matched the client's reader
+        (the client-service discovery race of ros2/rmw_fastrtps#418), and
+        the services under test are idempotent.
+        """
         client = self.node.create_client(srv_type, name)
+        end = time.monotonic() + timeout
         if not client.wait_for_service(timeout_sec=timeout):
             raise TimeoutError(f'service {name} not available')
-        future = client.call_async(request)
-        self.spin_until(future.done, timeout)
-        if not future.done():
-            raise TimeoutError(f'service {name} did not answer')
-        return future.result()
+        while True:
+            future = client.call_async(request)
+            left = end - time.monotonic()
+            if self.spin_until(future.done, max(0.0, min(resend, left))):
+                return future.result()
+            client.remove_pending_request(future)
+            if time.monotonic() >= end:
+                raise TimeoutError(f'service {name} did not answer')
 
     def close(self):
         self.executor.shutdown()

@@ -124,10 +124,18 @@ class PickRecorder(Recorder):
         request = SetParametersAtomically.Request(parameters=[
             Parameter(f'payload.{k}', value=v).to_parameter_msg()
             for k, v in payload.items()])
-        future = client.call_async(request)
         end = time.monotonic() + 10.0
-        while not future.done() and time.monotonic() < end:
-            self.spin_once(0.01)
+        future = None
+        while time.monotonic() < end:
+            # a fresh client's first response can be lost in discovery
+            # (ros2/rmw_fastrtps#418); setting the same values is idempotent
+            future = client.call_async(request)
+            resend = min(end, time.monotonic() + 2.0)
+            while not future.done() and time.monotonic() < resend:
+                self.spin_once(0.01)
+            if future.done():
+                break
+            client.remove_pending_request(future)
         if not future.done() or not future.result().result.successful:
             raise DemoError(f'{node}: setting the payload failed')
 

@@ -76,6 +76,10 @@ def test_a_burst_of_callers_is_answered(graph):
         for _ in range(CALLERS)]
     assert probe.spin_until(lambda: all(c.service_is_ready()
                                         for c in clients), 30.0)
+    # ready means the request path is matched; give the response path (the
+    # node's writer to each new client's reader) a moment too, or DDS may
+    # drop a first response (ros2/rmw_fastrtps#418): not the node's queue
+    probe.spin_for(1.0)
     request = ComputeDynamics.Request(
         name=[f'joint{i}' for i in range(1, 7)],
         position=[0.1, 0.2, 0.3, 0.4, 0.5, 0.6])

@@ -165,7 +165,8 @@ class Graph:
         # the service answers once the node is up and its kernels are warm
         assert self.client.wait_for_service(timeout_sec=90.0), \
             self.node.log()
-        assert self.call(ComputeDynamics.Request(), 90.0) is not None
+        assert self.probe.call(ComputeDynamics, SERVICE,
+                               ComputeDynamics.Request(), 90.0) is not None
         assert self.probe.spin_until(
             lambda: self.js.get_subscription_count() > 0
             and self.wr.get_subscription_count() > 0
