@@ -28,6 +28,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PythonExpression
 from launch_ros.actions import Node
+from newton_euler_ros.graph import INVERSE_DYNAMICS_TOPICS
 
 
 def generate_launch_description():
@@ -42,23 +43,16 @@ def generate_launch_description():
                                           'file to load'),
         DeclareLaunchArgument('params_file', default_value=params,
                               description='parameter file (overrides robot)'),
-        DeclareLaunchArgument('joint_states', default_value='joint_states'),
-        DeclareLaunchArgument('wrench', default_value='wrench'),
-        DeclareLaunchArgument(
-            'torque_command',
-            default_value='inverse_dynamics_node/torque_command',
-            description='topic of the Float64MultiArray command, e.g. '
-                        '/effort_controller/commands'),
+        *(DeclareLaunchArgument(arg, default_value=default,
+                                description=text)
+          for _, arg, default, text in INVERSE_DYNAMICS_TOPICS),
         Node(
             package='newton_euler_ros',
             executable='inverse_dynamics_node',
             name='inverse_dynamics_node',
             output='screen',
             parameters=[LaunchConfiguration('params_file')],
-            remappings=[
-                ('joint_states', LaunchConfiguration('joint_states')),
-                ('wrench', LaunchConfiguration('wrench')),
-                ('~/torque_command', LaunchConfiguration('torque_command')),
-            ],
+            remappings=[(name, LaunchConfiguration(arg))
+                        for name, arg, _, _ in INVERSE_DYNAMICS_TOPICS],
         ),
     ])

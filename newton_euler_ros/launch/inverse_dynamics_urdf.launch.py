@@ -31,6 +31,7 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
 from launch_ros.actions import Node
+from newton_euler_ros.graph import URDF_TOPICS
 
 
 def generate_launch_description():
@@ -46,15 +47,9 @@ def generate_launch_description():
             default_value=os.path.join(share, 'config', 'params',
                                        'urdf.yaml'),
             description='parameter file (wrench frames, QoS, ...)'),
-        DeclareLaunchArgument('robot_description',
-                              default_value='robot_description'),
-        DeclareLaunchArgument('joint_states', default_value='joint_states'),
-        DeclareLaunchArgument('wrench', default_value='wrench'),
-        DeclareLaunchArgument(
-            'torque_command',
-            default_value='inverse_dynamics_node/torque_command',
-            description='topic of the Float64MultiArray command, e.g. '
-                        '/effort_controller/commands'),
+        *(DeclareLaunchArgument(name, default_value=default,
+                                description=text)
+          for _, name, default, text in URDF_TOPICS),
         Node(
             package='newton_euler_ros',
             executable='inverse_dynamics_node',
@@ -63,11 +58,7 @@ def generate_launch_description():
             parameters=[arg('params_file'),
                         {'base_link': arg('base_link'),
                          'tip_link': arg('tip_link')}],
-            remappings=[
-                ('robot_description', arg('robot_description')),
-                ('joint_states', arg('joint_states')),
-                ('wrench', arg('wrench')),
-                ('~/torque_command', arg('torque_command')),
-            ],
+            remappings=[(topic, arg(name))
+                        for topic, name, _, _ in URDF_TOPICS],
         ),
     ])

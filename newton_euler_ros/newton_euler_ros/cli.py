@@ -257,8 +257,8 @@ def cmd_check(args):
 
 
 def cmd_simulate(args):
-    from .core.scene import load_scene
-    from .core.simulate import simulate
+    from .sim.scene import load_scene
+    from .sim.simulate import simulate
     scene = load_scene(args.scene)
     _warn(scene.warnings)
     if args.duration is not None and not args.duration > 0.0:

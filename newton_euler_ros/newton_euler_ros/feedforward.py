@@ -36,7 +36,7 @@ import numpy as np
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
                    inverse_dynamics, mass_matrix, Workspace)
 from .core.model import with_payload
-from .core.simulate import SceneDynamics
+from .sim.simulate import SceneDynamics
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
@@ -418,8 +418,7 @@ class FeedforwardComputer:
         """Inverse dynamics with the scene's effects, or all of them."""
         try:
             if self.dyn is not None:
-                return self.dyn.torques_for_wrench(q, qd, qdd, w, frame,
-                                                   out=out)
+                return self.dyn.torques(q, qd, qdd, w, frame, out=out)
             return inverse_dynamics(self.model, q, qd, qdd, w, frame,
                                     ws=self.ws, out=out)
         except DynamicsInputError as exc:   # finite input that overflows

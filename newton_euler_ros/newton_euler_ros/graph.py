@@ -20,7 +20,8 @@ The nodes use relative (``joint_states``, ``wrench``) or private
 loop of the demo is robot_sim_node -> inverse_dynamics_node ->
 tracking_controller_node -> robot_sim_node, with the nodes' default
 names; ``launch/closed_loop.launch.py`` and ``newton_euler_tools.demo``
-both take its remaps from here.
+both take its remaps from here, and the inverse-dynamics launch files
+their remappable topics.
 """
 SIM = '/robot_sim_node'
 ID = '/inverse_dynamics_node'
@@ -32,6 +33,24 @@ CONTROLLER_REMAPS = (
     ('~/reference', f'{ID}/reference'),
     ('~/commands', f'{SIM}/commands'),
 )
+
+
+#: (name in the node, launch argument, default, description) of the topics
+#: inverse_dynamics_node's launch files let a graph remap
+INVERSE_DYNAMICS_TOPICS = (
+    ('joint_states', 'joint_states', 'joint_states',
+     'sensor_msgs/JointState input'),
+    ('wrench', 'wrench', 'wrench', 'geometry_msgs/WrenchStamped input'),
+    ('~/torque_command', 'torque_command',
+     'inverse_dynamics_node/torque_command',
+     'topic of the Float64MultiArray command, e.g. '
+     '/effort_controller/commands'),
+)
+#: the same, for a node that reads its robot from the URDF
+URDF_TOPICS = (('robot_description', 'robot_description',
+                'robot_description',
+                'std_msgs/String URDF (reliable, transient local)'),
+               ) + INVERSE_DYNAMICS_TOPICS
 
 
 def ros_args(remaps):

@@ -27,8 +27,8 @@ import dataclasses
 import time
 import warnings
 
-from newton_euler_ros.core.scene import load_scene
-from newton_euler_ros.core.simulate import SceneDynamics
+from newton_euler_ros.sim.scene import load_scene
+from newton_euler_ros.sim.simulate import SceneDynamics
 import numpy as np
 
 EFFECTS = ('gravity', 'velocity_products', 'payload', 'wrench', 'friction',
@@ -73,9 +73,12 @@ def bench_scene(name, number, repeat):
     rows = []
     for label, sc in variants(scene):
         dyn = SceneDynamics(sc)
-        t_ff = _min_time(lambda: dyn.torques(q, qd, qdd, 0.0), number, repeat)
-        t_fd = _min_time(lambda: dyn.accelerations(q, qd, tau, 0.0),
-                         number // 4 or 1, repeat)
+        t_ff = _min_time(
+            lambda: dyn.torques(q, qd, qdd, *sc.wrench_at(0.0)),
+            number, repeat)
+        t_fd = _min_time(
+            lambda: dyn.accelerations(q, qd, tau, *sc.wrench_at(0.0)),
+            number // 4 or 1, repeat)
         rows.append((label, t_ff, t_fd))
     full_ff, full_fd = rows[0][1], rows[0][2]
     print(f'\n{scene.name} ({scene.model.name}, {n} joints): microseconds '

@@ -297,7 +297,7 @@ def torque_terms(scene, run):
     """Split the torques of a recorded run into the scene's terms."""
     from newton_euler_ros.core import (coriolis_matrix, gravity_torques,
                                        jacobian, mass_matrix)
-    from newton_euler_ros.core.simulate import SceneDynamics
+    from newton_euler_ros.sim.simulate import SceneDynamics
     dyn = SceneDynamics(scene)
     model, eff = scene.model, scene.effects
     t, q, qd = run['t'], run['q'], run['qd']
@@ -311,7 +311,7 @@ def torque_terms(scene, run):
         if eff.gravity:
             terms['g'][k] = gravity_torques(model, q[k])
         if eff.wrench:
-            w, frame = dyn.wrench(t[k])
+            w, frame = scene.wrench_at(t[k])
             terms['J^T F'][k] = jacobian(model, q[k], frame).T @ w
         if eff.friction:
             terms['friction'][k] = dyn.friction(qd[k])
@@ -477,7 +477,7 @@ def main(argv=None):
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
     from newton_euler_ros.core import NewtonEulerError
-    from newton_euler_ros.core.scene import load_scene
+    from newton_euler_ros.sim.scene import load_scene
     try:
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')

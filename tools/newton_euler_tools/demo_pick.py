@@ -257,7 +257,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     from newton_euler_ros.core import load_robot
-    from newton_euler_ros.core.scene import load_scene
+    from newton_euler_ros.sim.scene import load_scene
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
         scene = load_scene(SCENE)

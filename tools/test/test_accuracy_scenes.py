@@ -17,8 +17,8 @@ import dataclasses
 import math
 
 from newton_euler_ros.core import wrench_torques
-from newton_euler_ros.core.simulate import (SceneDynamics, simulate,
-                                            tracking_controller)
+from newton_euler_ros.sim.simulate import (SceneDynamics, simulate,
+                                           tracking_controller)
 from newton_euler_tools.accuracy import scenes as S
 import numpy as np
 import pytest
@@ -136,7 +136,7 @@ def test_precomputed_feedforward_equals_online(records, puma):
     QD[3] = 0.0                      # sign(0) of the Coulomb term too
     W, frame = S.wrench_series(puma, T)
     batch = S.scene_torques_batch(puma, Q, QD, QDD, W, frame)
-    rows = np.array([dyn.torques(q, qd, qdd, t)
+    rows = np.array([dyn.torques(q, qd, qdd, *puma.wrench_at(t))
                      for t, q, qd, qdd in zip(T, Q, QD, QDD)])
     assert np.array_equal(batch, rows)
 
@@ -166,8 +166,9 @@ def test_measured_feedforward_uses_the_measured_state(puma):
     qd = qd_d + 0.05
     tau_m, ff_m = measured(t, q, qd)
     tau_d, ff_d = desired(t, q, qd)
-    assert np.array_equal(ff_m, dyn.torques(q, qd, qdd_d, t))
-    assert np.array_equal(ff_d, dyn.torques(q_d, qd_d, qdd_d, t))
+    w = puma.wrench_at(t)
+    assert np.array_equal(ff_m, dyn.torques(q, qd, qdd_d, *w))
+    assert np.array_equal(ff_d, dyn.torques(q_d, qd_d, qdd_d, *w))
     # gravity on the shoulder changes by about dg/dq * 0.1 (> 1 N m)
     assert abs(ff_m[1] - ff_d[1]) > 1.0
     # the PD part is the same
@@ -183,12 +184,13 @@ def test_simulate_feedforward_at_measured(puma):
     for k in range(0, steps, 7):
         t = r.t[k]
         q_d, qd_d, qdd_d = puma.reference.at(t)
+        w = puma.wrench_at(t)
         assert np.array_equal(r.tau_ff[k],
-                              dyn.torques(r.q[k], r.qd[k], qdd_d, t))
+                              dyn.torques(r.q[k], r.qd[k], qdd_d, *w))
         assert np.array_equal(d.tau_ff[k],
-                              dyn.torques(q_d, qd_d, qdd_d, t))
+                              dyn.torques(q_d, qd_d, qdd_d, *w))
         diff = max(diff, float(np.abs(
-            r.tau_ff[k] - dyn.torques(q_d, qd_d, qdd_d, t)).max()))
+            r.tau_ff[k] - dyn.torques(q_d, qd_d, qdd_d, *w)).max()))
     assert diff > 1e-3         # the arm is off the reference: they differ
 
 

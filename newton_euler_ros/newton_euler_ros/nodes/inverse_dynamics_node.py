@@ -53,7 +53,6 @@ from .common import (check_parameters, ConfigurationError,
                      declare_parameters, plain, qos_profile, release_memory,
                      run_node)
 from ..core import inspect_robot, NewtonEulerError
-from ..core.scene import load_scene
 from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
 from ..feedforward import (check_payload, clip, FeedforwardComputer,
@@ -62,6 +61,7 @@ from ..feedforward import (check_payload, clip, FeedforwardComputer,
 from ..parameters import load_specs
 from ..safety import (effort_bounds, TorqueGuard, velocity_bounds,
                       wrench_bounds)
+from ..sim.scene import load_scene
 
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',

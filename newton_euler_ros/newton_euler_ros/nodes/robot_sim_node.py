@@ -69,12 +69,12 @@ from trajectory_msgs.msg import JointTrajectory
 from .common import (check_parameters, ConfigurationError,
                      declare_parameters, qos_profile, run_node)
 from ..core import NewtonEulerError
-from ..core.scene import load_scene
-from ..core.simulate import integrator_step, SceneDynamics
 from ..core.trajectory import TrajectoryFollower
 from ..feedforward import payload_model
 from ..parameters import load_specs
 from ..safety import effort_bounds, TorqueGuard
+from ..sim.scene import load_scene
+from ..sim.simulate import integrator_step, SceneDynamics
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -85,18 +85,20 @@ FIRST_COMMAND = 1.0     # seconds t = 0 is held for the first command
 FUTURE = 1.0    # seconds: a live wrench stamped further ahead is dropped
 
 
-def advance(dyn, q, qd, tau, t, period, dt, method):
+def advance(dyn, q, qd, tau, t, period, dt, method, wrench_at=None):
     """
     Advance (q, qd) by ``period`` of simulated time from ``t``.
 
     Sub-steps of at most ``dt`` with the scene's integrator, holding
-    ``tau`` (zero-order hold), as :func:`..core.simulate.simulate` does.
+    ``tau`` (zero-order hold), as :func:`..sim.simulate.simulate` does;
+    ``wrench_at(t) -> (wrench, frame)`` as for ``integrator_step``.
     Return the new (q, qd).
     """
     steps = max(1, int(math.ceil(period / dt - 1e-9)))
     h = period / steps
     for k in range(steps):
-        q, qd = integrator_step(dyn, method, q, qd, tau, t + k * h, h)
+        q, qd = integrator_step(dyn, method, q, qd, tau, t + k * h, h,
+                                wrench_at)
     return q, qd
 
 
@@ -143,6 +145,11 @@ class RobotSimNode(Node):
         self.ready_since = None
         self.dropped = 0
         self._last_warn = -1e300
+        # the wrench the plant feels: the scene's own, or the latest one
+        # from the topic (zero until one arrives; kept across payloads)
+        self.live = scene.effects.wrench and scene.wrench.kind == 'topic'
+        self.live_wrench = (np.zeros(6), scene.wrench.frame
+                            if scene.effects.wrench else 'base')
         # compile or load the kernels before the clock starts
         advance(self.dyn, self.q, self.qd, self.tau, 0.0, scene.step,
                 scene.step, scene.integrator)
@@ -151,12 +158,12 @@ class RobotSimNode(Node):
         qos = qos_profile(100, 'reliable')
         self.state_pub = self.create_publisher(JointState, 'joint_states',
                                                qos)
-        live = scene.effects.wrench and scene.wrench.kind == 'topic'
         # a scheduled wrench is published; a live one is read from the topic
         self.wrench_pub = (self.create_publisher(WrenchStamped, 'wrench',
                                                  qos)
-                           if scene.effects.wrench and not live else None)
-        if live:
+                           if scene.effects.wrench and not self.live
+                           else None)
+        if self.live:
             self.create_subscription(WrenchStamped, 'wrench',
                                      self._on_wrench, qos)
         latched = QoSProfile(depth=1,
@@ -258,7 +265,8 @@ class RobotSimNode(Node):
                 self.q, self.qd = advance(self.dyn, self.q, self.qd, tau,
                                           self.t, self.period,
                                           self.scene.step,
-                                          self.scene.integrator)
+                                          self.scene.integrator,
+                                          self._wrench_at)
                 self.t = t_next
                 self.applied = tau
         stamp = Time(nanoseconds=self.start_ns
@@ -358,8 +366,11 @@ class RobotSimNode(Node):
                 f'than {FUTURE} s ahead ({ahead:.3f} s): {w.tolist()}',
                 throttle_duration_sec=2.0)
             return
-        self.dyn.live_wrench = w
-        self.dyn.live_frame = frame
+        self.live_wrench = (w, frame)
+
+    def _wrench_at(self, t):
+        """Return (wrench or None, frame) the plant feels at time t."""
+        return self.live_wrench if self.live else self.scene.wrench_at(t)
 
     def _publish_wrench(self, stamp):
         if self.wrench_pub is None:

@@ -54,9 +54,9 @@ from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 from .common import (ConfigurationError, declare_parameters, qos_profile,
                      run_node)
 from ..core import NewtonEulerError
-from ..core.scene import load_scene
-from ..core.simulate import pd_torque
 from ..parameters import load_specs
+from ..sim.scene import load_scene
+from ..sim.simulate import pd_torque
 
 SAMPLE = 0.01           # reference sampling period, seconds
 PENDING = 32            # joint states / feedforward kept for matching

@@ -146,8 +146,8 @@ def test_computer_matches_library_with_reference_and_wrench(puma):
 
 
 def test_scene_selects_the_nodes_effects():
-    from newton_euler_ros.core.scene import load_scene
-    from newton_euler_ros.core.simulate import SceneDynamics
+    from newton_euler_ros.sim.scene import load_scene
+    from newton_euler_ros.sim.simulate import SceneDynamics
     orbit = load_scene('panda_orbit_slow')       # no gravity
     order = JointOrder(orbit.model.joint_names)
     ff = FeedforwardComputer(None, order, WrenchInput([], []), None, orbit)
@@ -169,7 +169,7 @@ def test_scene_selects_the_nodes_effects():
     ff = FeedforwardComputer(None, order, WrenchInput([], []), None, press)
     rng = np.random.default_rng(5)
     q, qd = rng.normal(size=(2, 6))
-    expected = SceneDynamics(press).torques_for_wrench(q, qd, None, None)
+    expected = SceneDynamics(press).torques(q, qd, None, None)
     got = ff.torques(names6(), q, qd, stamp=0.0, now=0.0)
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-12)
     with warnings.catch_warnings():

@@ -363,8 +363,8 @@ def test_reference_accelerations_enter_the_torques(tmp_path, model):
 
 
 def test_scene_parameter_selects_effects(tmp_path):
-    from newton_euler_ros.core.scene import load_scene
-    from newton_euler_ros.core.simulate import SceneDynamics
+    from newton_euler_ros.sim.scene import load_scene
+    from newton_euler_ros.sim.simulate import SceneDynamics
     scene = load_scene('puma_payload_press')
     domain = domain_id(43)
     node = NodeProcess(node_cmd('-p', 'scene:=puma_payload_press'), domain,
@@ -378,7 +378,7 @@ def test_scene_parameter_selects_effects(tmp_path):
         res = probe.call(ComputeDynamics, f'{NODE}/compute_dynamics', req,
                          timeout=90.0)
         assert res.success, res.message
-        expected = SceneDynamics(scene).torques_for_wrench(q, qd, None, None)
+        expected = SceneDynamics(scene).torques(q, qd, None, None)
         np.testing.assert_allclose(res.torque, expected, rtol=0, atol=1e-12)
         assert "effects ['gravity', 'velocity_products', 'payload'" \
             in node.log()

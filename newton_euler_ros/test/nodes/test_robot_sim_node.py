@@ -36,7 +36,7 @@ pytest.importorskip('rclpy')
 from geometry_msgs.msg import WrenchStamped  # noqa: E402, I100
 from newton_euler_ros.core import (forward_dynamics, jacobian,  # noqa: E402
                                    mass_matrix)
-from newton_euler_ros.core.scene import load_scene  # noqa: E402
+from newton_euler_ros.sim.scene import load_scene  # noqa: E402
 from ros_harness import domain_id, NodeProcess, Probe  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
 

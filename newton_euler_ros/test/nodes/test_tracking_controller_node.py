@@ -25,6 +25,7 @@ import ast
 import os
 import sys
 
+from newton_euler_ros import graph
 from newton_euler_ros.graph import CONTROLLER_REMAPS, ros_args
 import pytest
 
@@ -93,19 +94,33 @@ def test_names_are_relative_or_private(tmp_path, namespace, remap,
     assert status == 0, node.log()
 
 
-def test_launch_file_uses_the_graph_remaps():
-    """closed_loop.launch.py takes the controller's remaps from graph.py."""
-    path = os.path.join(PACKAGE_DIR, 'launch', 'closed_loop.launch.py')
+@pytest.mark.parametrize('launch_file, names', [
+    ('closed_loop.launch.py', ('CONTROLLER_REMAPS',)),
+    ('inverse_dynamics.launch.py', ('INVERSE_DYNAMICS_TOPICS',)),
+    ('inverse_dynamics_urdf.launch.py', ('URDF_TOPICS',)),
+])
+def test_launch_files_take_their_wiring_from_graph(launch_file, names):
+    """The launch files' remaps come from graph.py, written once there."""
+    path = os.path.join(PACKAGE_DIR, 'launch', launch_file)
     tree = ast.parse(open(path).read())
     imported = {alias.name for n in ast.walk(tree)
                 if isinstance(n, ast.ImportFrom)
                 and n.module == 'newton_euler_ros.graph'
                 for alias in n.names}
-    assert 'CONTROLLER_REMAPS' in imported
+    assert set(names) <= imported
     remappings = [kw.value for n in ast.walk(tree) if isinstance(n, ast.Call)
                   for kw in n.keywords if kw.arg == 'remappings']
-    assert len(remappings) == 1 and 'CONTROLLER_REMAPS' in ast.dump(
-        remappings[0])
+    assert len(remappings) == 1
+    assert all(name in ast.dump(remappings[0]) for name in names)
+    # no topic is named in the file itself
+    for name, _, default, _ in graph.URDF_TOPICS:
+        assert repr(name) not in ast.unparse(tree), name
+
+
+def test_graph_topics_are_the_nodes_defaults():
+    """Every remappable topic's default is the node's own name for it."""
+    for name, _, default, _ in graph.URDF_TOPICS:
+        assert default == name.replace('~', 'inverse_dynamics_node')
 
 
 @pytest.mark.parametrize('feedforward', [False, True])

@@ -20,9 +20,9 @@ from newton_euler_ros.core import (gravity_torques, inverse_dynamics,
                                    load_robot, RobotFileError)
 from newton_euler_ros.core.model import with_payload
 from newton_euler_ros.core.robot_file import read_yaml
-from newton_euler_ros.core.scene import load_scene, scene_dirs, \
+from newton_euler_ros.sim.scene import load_scene, scene_dirs, \
     scene_from_dict
-from newton_euler_ros.core.simulate import SceneDynamics, simulate
+from newton_euler_ros.sim.simulate import SceneDynamics, simulate
 import numpy as np
 import pytest
 
@@ -59,7 +59,7 @@ def test_zero_gravity_never_evaluates_gravity(monkeypatch):
         seen.append(bool(args[5] & K.GRAVITY))    # the gravity flag
         return real(*args)
     monkeypatch.setattr(dynamics, '_tau', spy)
-    tau = dyn.torques(q, np.zeros(6), np.zeros(6), 0.0)
+    tau = dyn.torques(q, np.zeros(6), np.zeros(6), *scene.wrench_at(0.0))
     assert seen == [False]
     assert np.all(tau == 0.0)         # exactly zero, not round-off
     # and the gravity vector really is irrelevant: change it, same torques
@@ -74,15 +74,15 @@ def test_effects_select_terms(default_scene):
     orbit = load_scene('panda_orbit_slow')
     assert orbit.effects.names() == ['velocity_products']
     dyn = SceneDynamics(orbit)
-    assert np.all(dyn.torques(orbit.q0, np.zeros(7), np.zeros(7), 0.0)
-                  == 0.0)                 # at rest in orbit: exactly zero
+    # at rest in orbit: exactly zero
+    assert np.all(dyn.torques(orbit.q0, np.zeros(7), np.zeros(7)) == 0.0)
     slow = load_scene('panda_slow_earth')
     assert slow.effects.names() == ['gravity']
     dyn = SceneDynamics(slow)
     q, qd = slow.q0, np.full(7, 0.3)
     # with no velocity products, torques at rest and in motion agree
-    assert np.array_equal(dyn.torques(q, qd, np.zeros(7), 0.0),
-                          dyn.torques(q, np.zeros(7), np.zeros(7), 0.0))
+    assert np.array_equal(dyn.torques(q, qd, np.zeros(7)),
+                          dyn.torques(q, np.zeros(7), np.zeros(7)))
 
 
 def test_left_out_velocity_products_are_negligible():
@@ -255,22 +255,27 @@ def test_numbers_as_strings_are_coerced():
 
 
 def test_live_wrench_equals_constant_wrench():
-    """A topic-fed wrench, once set, acts exactly like a constant one."""
+    """A topic-fed wrench, passed in, acts exactly like a constant one."""
     data, folder = bundled('puma_payload_press')
     live = copy.deepcopy(data)
     live['effects']['wrench'] = {'frame': 'end_effector', 'source': 'topic'}
     const = copy.deepcopy(data)
     w = [1.0, -2.0, 30.0, 0.1, 0.2, -0.3]
     const['effects']['wrench'] = {'frame': 'end_effector', 'constant': w}
-    d_live = SceneDynamics(scene_from_dict(live, 'l.yaml', folder))
-    d_const = SceneDynamics(scene_from_dict(const, 'c.yaml', folder))
+    s_live = scene_from_dict(live, 'l.yaml', folder)
+    s_const = scene_from_dict(const, 'c.yaml', folder)
+    d_live, d_const = SceneDynamics(s_live), SceneDynamics(s_const)
     q, qd, tau = np.full(6, 0.3), np.full(6, -0.2), np.ones(6)
-    offline = d_live.accelerations(q, qd, tau, 0.0)     # zero until set
-    d_live.live_wrench = np.array(w)
-    np.testing.assert_array_equal(d_live.accelerations(q, qd, tau, 0.0),
-                                  d_const.accelerations(q, qd, tau, 0.0))
-    assert np.abs(offline - d_const.accelerations(q, qd, tau, 0.0)).max() \
-        > 1e-3
+    # offline, a topic's wrench is zero
+    assert np.array_equal(s_live.wrench_at(5.0)[0], np.zeros(6))
+    offline = d_live.accelerations(q, qd, tau, *s_live.wrench_at(0.0))
+    expected = d_const.accelerations(q, qd, tau, *s_const.wrench_at(0.0))
+    np.testing.assert_array_equal(
+        d_live.accelerations(q, qd, tau, np.array(w), 'end_effector'),
+        expected)
+    assert np.abs(offline - expected).max() > 1e-3
+    # the wrench reaches the dynamics only as an argument
+    assert not any('wrench' in k for k in vars(d_live))
 
 
 @pytest.mark.parametrize('name', ['puma_payload_press', 'panda_orbit_slow',
@@ -287,7 +292,7 @@ def test_scene_controller_is_stable_sampled_at_its_rate(name):
     import dataclasses
 
     from newton_euler_tools.accuracy.scenes import held_controller
-    from newton_euler_ros.core.simulate import simulate
+    from newton_euler_ros.sim.simulate import simulate
     scene = load_scene(name)
     for gain in (1.0, 1.5):
         sc = dataclasses.replace(scene, kp=gain * scene.kp,

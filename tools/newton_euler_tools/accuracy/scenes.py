@@ -15,7 +15,7 @@
 """
 Scene experiments: what a modelling or simulation choice costs and buys.
 
-Four experiments on a scene (a :class:`..core.scene.Scene` or a bundled
+Four experiments on a scene (a :class:`..sim.scene.Scene` or a bundled
 scene's name), each returning records (plain dicts with ``section``,
 ``robot``, ``scene``, ``quantity``, ``method``, ``us``, ``error``,
 ``note`` and extra keys) for :mod:`.report`:
@@ -44,10 +44,10 @@ import warnings
 from newton_euler_ros.core import (inverse_dynamics, inverse_dynamics_batch,
                                    Workspace)
 from newton_euler_ros.core.robot_file import RobotFileWarning
-from newton_euler_ros.core.scene import INTEGRATORS, load_scene
-from newton_euler_ros.core.simulate import (friction_torque, integrator_step,
-                                            SceneDynamics, simulate,
-                                            tracking_controller)
+from newton_euler_ros.sim.scene import INTEGRATORS, load_scene
+from newton_euler_ros.sim.simulate import (friction_torque, integrator_step,
+                                           SceneDynamics, simulate,
+                                           tracking_controller)
 import numpy as np
 
 from ..bench import Timer
@@ -121,7 +121,7 @@ def wrench_series(scene, T):
     Return (W, frame): the scene's wrench at the times ``T``.
 
     ``W`` is (m, 6), or None when the scene has no wrench.  A wrench read
-    from a topic is zero offline, as in :class:`SceneDynamics`.
+    from a topic is zero offline, as in :meth:`Scene.wrench_at`.
     """
     if not scene.effects.wrench:
         return None, 'base'
@@ -391,8 +391,11 @@ def feedforward_placement(scene, quick=False):
           'QDD': QDD, 'W': W, 'frame': frame, 'ws': Workspace(scene.model),
           'FF': ff}
     times = Timer(quick).group({
-        'desired state': ('dyn.torques(q_d, qd_d, qdd_d, t)', ns, None, 1),
-        'measured state': ('dyn.torques(q, qd, qdd_d, t)', ns, None, 1),
+        'desired state': (
+            'dyn.torques(q_d, qd_d, qdd_d, *scene.wrench_at(t))', ns, None,
+            1),
+        'measured state': (
+            'dyn.torques(q, qd, qdd_d, *scene.wrench_at(t))', ns, None, 1),
         'precomputed': ('batch(scene, Q, QD, QDD, W, frame, ws=ws, out=FF)',
                         ns, None, steps)})
     scene_torques_batch(scene, Q, QD, QDD, W, frame, out=ff)

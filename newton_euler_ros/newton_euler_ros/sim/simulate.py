@@ -31,9 +31,9 @@ import time
 
 import numpy as np
 
-from .dynamics import (inverse_dynamics, jacobian, link_poses, mass_matrix,
-                       solve_mass_matrix, Workspace)
 from .scene import INTEGRATORS
+from ..core.dynamics import (inverse_dynamics, jacobian, link_poses,
+                             mass_matrix, solve_mass_matrix, Workspace)
 
 
 def pd_torque(scene, q_d, qd_d, q, qd):
@@ -47,7 +47,15 @@ def friction_torque(scene, qd):
 
 
 class SceneDynamics:
-    """The dynamics of one scene, with a reusable workspace."""
+    """
+    The dynamics of one scene's effects, with a reusable workspace.
+
+    Every method takes the end-effector wrench as an argument (None:
+    none), in ``frame`` 'base' or 'end_effector'; it is ignored, and no
+    Jacobian is formed, unless the scene has the wrench effect.  Where the
+    wrench comes from (the scene's schedule, :meth:`Scene.wrench_at`, or
+    a live topic) is the caller's business.
+    """
 
     def __init__(self, scene):
         self.scene = scene
@@ -56,41 +64,13 @@ class SceneDynamics:
         self.ws = Workspace(scene.model)
         n = scene.model.n
         self._D = np.zeros((n, n))
-        self.live_wrench = np.zeros(6)
-        self.live_frame = (scene.wrench.frame if scene.wrench is not None
-                           else 'base')
-
-    def wrench(self, t):
-        """
-        Return (wrench or None, frame) at time t.
-
-        A scene whose wrench comes from a topic uses ``live_wrench`` and
-        ``live_frame``, which a ROS adapter keeps up to date (zero
-        offline).
-        """
-        if not self.effects.wrench:
-            return None, 'base'
-        if self.scene.wrench.kind == 'topic':
-            return self.live_wrench, self.live_frame
-        return self.scene.wrench.at(t), self.scene.wrench.frame
 
     def friction(self, qd):
         """Friction torque the joints lose (:func:`friction_torque`)."""
         return friction_torque(self.scene, qd)
 
-    def torques(self, q, qd, qdd, t):
-        """Inverse dynamics with exactly the scene's effects at time t."""
-        w, frame = self.wrench(t)
-        return self.torques_for_wrench(q, qd, qdd, w, frame)
-
-    def torques_for_wrench(self, q, qd, qdd, wrench, frame='base',
-                           out=None):
-        """
-        Inverse dynamics with the scene's effects and a given wrench.
-
-        ``wrench`` is ignored (no Jacobian is formed) unless the scene has
-        the wrench effect; ``qdd`` may be None (zeros).
-        """
+    def torques(self, q, qd, qdd, wrench=None, frame='base', out=None):
+        """Inverse dynamics with exactly the scene's effects; qdd may be None."""
         eff = self.effects
         if not eff.wrench:
             wrench = None
@@ -111,9 +91,9 @@ class SceneDynamics:
             D.flat[::D.shape[0] + 1] += self.scene.armature
         return D
 
-    def accelerations(self, q, qd, tau, t):
+    def accelerations(self, q, qd, tau, wrench=None, frame='base'):
         """Forward dynamics: qdd for applied torques ``tau``."""
-        bias = self.torques(q, qd, np.zeros_like(q), t)
+        bias = self.torques(q, qd, None, wrench, frame)
         D = self.mass_matrix(q, out=self._D)
         return solve_mass_matrix(self.model, q, D, tau - bias, ws=self.ws)
 
@@ -130,14 +110,13 @@ class SceneDynamics:
                 U -= self.model.mass[j] * (g @ c)
         return T + U
 
-    def power(self, q, qd, tau, t):
+    def power(self, q, qd, tau, wrench=None, frame='base'):
         """(P_tau, P_friction, P_wrench): power into the robot."""
         p_tau = qd @ tau
         p_f = -(qd @ self.friction(qd)) if self.effects.friction else 0.0
         p_w = 0.0
-        if self.effects.wrench:
-            w, frame = self.wrench(t)
-            p_w = -(jacobian(self.model, q, frame, ws=self.ws) @ qd) @ w
+        if self.effects.wrench and wrench is not None:
+            p_w = -(jacobian(self.model, q, frame, ws=self.ws) @ qd) @ wrench
         return p_tau, p_f, p_w
 
 
@@ -175,16 +154,20 @@ def advance(method, accel, q, qd, t, h, power=None):
                      f'got {method!r}')
 
 
-def integrator_step(dyn, method, q, qd, tau, t, h):
+def integrator_step(dyn, method, q, qd, tau, t, h, wrench_at=None):
     """
     Return (q, qd) one step of ``h`` later, holding the torques ``tau``.
 
     The stepping of the simulator node and of the integrator
-    measurements: :func:`step` on the scene's forward dynamics.
+    measurements: :func:`advance` on the scene's forward dynamics.
+    ``wrench_at(t) -> (wrench or None, frame)`` gives the wrench at each
+    stage (default: the scene's own, :meth:`Scene.wrench_at`).
     """
-    q, qd, _ = advance(method,
-                       lambda t, q, qd: dyn.accelerations(q, qd, tau, t),
-                       q, qd, t, h)
+    wrench_at = wrench_at or dyn.scene.wrench_at
+    q, qd, _ = advance(
+        method,
+        lambda t, q, qd: dyn.accelerations(q, qd, tau, *wrench_at(t)),
+        q, qd, t, h)
     return q, qd
 
 
@@ -219,9 +202,9 @@ def tracking_controller(dyn, feedforward=None, feedforward_at='desired'):
         if not use_ff:
             ff = np.zeros_like(q)
         elif measured:
-            ff = dyn.torques(q, qd, qdd_d, t)
+            ff = dyn.torques(q, qd, qdd_d, *scene.wrench_at(t))
         else:
-            ff = dyn.torques(q_d, qd_d, qdd_d, t)
+            ff = dyn.torques(q_d, qd_d, qdd_d, *scene.wrench_at(t))
         return tau + ff, ff
     return control
 
@@ -308,8 +291,12 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
         tau, ff = control(t, q, qd)
         out_tau[k], out_ff[k] = tau, ff
         q, qd, w = advance(
-            method, lambda t, q, qd: dyn.accelerations(q, qd, tau, t), q, qd,
-            t, dt, lambda t, q, qd: np.array(dyn.power(q, qd, tau, t)))
+            method,
+            lambda t, q, qd: dyn.accelerations(q, qd, tau,
+                                               *scene.wrench_at(t)),
+            q, qd, t, dt,
+            lambda t, q, qd: np.array(dyn.power(q, qd, tau,
+                                                *scene.wrench_at(t))))
         work = work + w
         if bar is not None:
             bar.update(1)

@@ -27,10 +27,10 @@ import os
 
 import numpy as np
 
-from .errors import RobotFileError
-from .model import inertia_matrix, with_payload
-from .robot_file import (_check_keys, _short, inspect_robot, read_yaml, to_number,
-                         to_vector)
+from ..core.errors import RobotFileError
+from ..core.model import inertia_matrix, with_payload
+from ..core.robot_file import (_check_keys, _short, inspect_robot, read_yaml,
+                               to_number, to_vector)
 
 SCENE_KEYS = {'name', 'description', 'robot', 'effects', 'initial',
               'reference', 'controller', 'integrator'}
@@ -137,6 +137,17 @@ class Scene:
     duration: float
     rate: float
     warnings: tuple = ()
+
+    def wrench_at(self, t):
+        """
+        Return (wrench or None, frame): the scene's own wrench at time t.
+
+        None when the scene has no wrench effect.  A wrench read from a
+        topic is zero here; the ROS adapter passes the live one instead.
+        """
+        if not self.effects.wrench:
+            return None, 'base'
+        return self.wrench.at(t), self.wrench.frame
 
 
 def _flag_or_block(value, where):
@@ -350,7 +361,7 @@ def scene_from_dict(data, origin, base_dir='.'):
 
 def scene_dirs():
     """Folders searched for bundled scenes."""
-    from .robot_file import bundled_dirs
+    from ..core.robot_file import bundled_dirs
     return [os.path.join(os.path.dirname(d), 'scenes')
             for d in bundled_dirs()]
 
