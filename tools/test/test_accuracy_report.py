@@ -186,3 +186,24 @@ def test_report_rerenders_from_its_records(quick_report, tmp_path):
          str(tmp_path / 'missing.json')], capture_output=True, text=True,
         timeout=300)
     assert bad.returncode == 2 and 'cannot read records' in bad.stderr
+
+
+def test_report_modules_import_no_cycle():
+    """The report's modules form a layered graph: no two import each other."""
+    import ast
+    folder = os.path.dirname(plots.__file__)
+    graph = {}
+    for name in os.listdir(folder):
+        if name.endswith('.py'):
+            with open(os.path.join(folder, name), encoding='utf-8') as fh:
+                tree = ast.parse(fh.read())
+            graph[name[:-3]] = {
+                (n.module or '').split('.')[0] for n in ast.walk(tree)
+                if isinstance(n, ast.ImportFrom) and n.level == 1}
+
+    def reaches(start, goal, seen=()):
+        return any(m == goal or (m in graph and m not in seen
+                                 and reaches(m, goal, seen + (m,)))
+                   for m in graph.get(start, ()))
+    cycles = [m for m in graph if reaches(m, m)]
+    assert not cycles, {m: sorted(graph[m]) for m in cycles}

@@ -23,7 +23,7 @@ import os
 
 from . import plots
 from .arithmetic import EPS
-from .report import (ARITH_HEADER, arithmetic_rows, find, fmt_err, fmt_us,
+from .tables import (ARITH_HEADER, arithmetic_rows, find, fmt_err, fmt_us,
                      md_table, save_records, scaling_header, scaling_rows,
                      scene_tables)
 
