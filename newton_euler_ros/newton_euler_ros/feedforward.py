@@ -34,9 +34,9 @@ import math
 import numpy as np
 
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
-                   inverse_dynamics, mass_matrix, Workspace)
+                   inverse_dynamics, mass_matrix)
+from .core.effects import EffectDynamics
 from .core.model import with_payload
-from .sim.simulate import SceneDynamics
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
@@ -403,12 +403,17 @@ class FeedforwardComputer:
             raise ValueError(f'mode must be one of {", ".join(MODES)}, got '
                              f'{self.mode!r}')
         self.scene = scene
-        self.dyn = SceneDynamics(scene) if scene is not None else None
-        self.model = scene.model if scene is not None else model
+        # the live torques: exactly the scene's effects, or every
+        # rigid-body term and the wrench without a scene
+        self.dyn = (EffectDynamics(scene.model, scene.effects,
+                                   scene.viscous, scene.coulomb,
+                                   scene.armature)
+                    if scene is not None else EffectDynamics(model))
+        self.model = self.dyn.model
         self.order = order
         self.wrench = wrench_input
         self.reference = reference
-        self.ws = self.dyn.ws if self.dyn is not None else Workspace(model)
+        self.ws = self.dyn.ws
         self.tau = np.empty(self.model.n)
         self.zeros = np.zeros(self.model.n)
         self.last_q = None
@@ -417,10 +422,7 @@ class FeedforwardComputer:
     def _torques(self, q, qd, qdd, w, frame, out=None):
         """Inverse dynamics with the scene's effects, or all of them."""
         try:
-            if self.dyn is not None:
-                return self.dyn.torques(q, qd, qdd, w, frame, out=out)
-            return inverse_dynamics(self.model, q, qd, qdd, w, frame,
-                                    ws=self.ws, out=out)
+            return self.dyn.torques(q, qd, qdd, w, frame, out=out)
         except DynamicsInputError as exc:   # finite input that overflows
             raise InputRejected('non_finite', str(exc)) from None
 
@@ -512,16 +514,14 @@ class FeedforwardComputer:
         qdd = (np.zeros(n) if len(acceleration) == 0 else
                self.order.gather(names, 'acceleration', acceleration))
         w, frame = self.wrench.current(now)
-        D = (self.dyn.mass_matrix(q) if self.dyn is not None
-             else mass_matrix(self.model, q, ws=self.ws))
+        D = self.dyn.mass_matrix(q)
         C = coriolis_matrix(self.model, q, qd, ws=self.ws)
         g = gravity_torques(self.model, q, ws=self.ws)
-        if self.scene is not None:      # the terms the scene has
-            eff = self.scene.effects
-            if not eff.velocity_products:
-                C[:] = 0.0
-            if not eff.gravity:
-                g[:] = 0.0
+        eff = self.dyn.effects          # the terms the scene has
+        if not eff.velocity_products:
+            C[:] = 0.0
+        if not eff.gravity:
+            g[:] = 0.0
         tau = self._torques(q, qd, qdd, w, frame)
         o = self.order
         out = (o.matrix_to_output_order(D), o.matrix_to_output_order(C),

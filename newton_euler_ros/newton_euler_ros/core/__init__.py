@@ -26,18 +26,18 @@ from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        inverse_dynamics_batch, jacobian, link_poses,
                        mass_matrix, mass_matrix_batch, mass_matrix_condition,
                        velocity_products, wrench_torques)
+from .effects import EffectDynamics, Effects
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
 from .float32 import Float32Dynamics
 from .model import make_model, pose_matrix, RobotModel, rpy_matrix
 from .robot_file import (bundled_robots, inspect_robot, load_robot,
                          robot_from_dict, RobotFileWarning)
-
 from .workspace import Workspace
 
 __all__ = [
-    'DynamicsInputError', 'Float32Dynamics', 'NewtonEulerError',
-    'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
+    'DynamicsInputError', 'EffectDynamics', 'Effects', 'Float32Dynamics',
+    'NewtonEulerError', 'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
     'RobotModel', 'Workspace', 'bundled_robots', 'coriolis_matrix',
     'coriolis_matrix_batch', 'end_effector_pose', 'forward_dynamics',
     'forward_dynamics_batch', 'gravity_torques', 'gravity_torques_batch',

@@ -27,6 +27,7 @@ import os
 
 import numpy as np
 
+from ..core.effects import Effects
 from ..core.errors import RobotFileError
 from ..core.model import inertia_matrix, with_payload
 from ..core.robot_file import (_check_keys, _short, inspect_robot, read_yaml,
@@ -37,24 +38,6 @@ SCENE_KEYS = {'name', 'description', 'robot', 'effects', 'initial',
 EFFECT_KEYS = {'gravity', 'velocity_products', 'payload', 'wrench',
                'friction', 'armature'}
 INTEGRATORS = ('rk4', 'semi_implicit_euler')
-
-
-@dataclass(frozen=True)
-class Effects:
-    """Which terms of the dynamics a scene has."""
-
-    gravity: bool = True
-    velocity_products: bool = True
-    payload: bool = False
-    wrench: bool = False
-    friction: bool = False
-    armature: bool = False
-
-    def names(self):
-        """Return the enabled effects, in a fixed order."""
-        return [k for k in ('gravity', 'velocity_products', 'payload',
-                            'wrench', 'friction', 'armature')
-                if getattr(self, k)]
 
 
 @dataclass(frozen=True)

@@ -15,11 +15,11 @@
 """
 Deterministic simulation of a scene, paying only for its effects.
 
-The scene's effects select the terms: without gravity the recursion
-skips gravity entirely, without velocity products it skips every
-velocity term, without a wrench no Jacobian is formed, and friction and
-rotor inertia are added only when present.  Forward dynamics solve
-``(D + diag(armature)) qdd = tau - bias`` by Cholesky.
+The scene's effects select the terms (:mod:`..core.effects`): without
+gravity the recursion skips gravity entirely, without velocity products
+it skips every velocity term, without a wrench no Jacobian is formed, and
+friction and rotor inertia are added only when present.  Forward
+dynamics solve ``(D + diag(armature)) qdd = tau - bias`` by Cholesky.
 
 Energy bookkeeping integrates, alongside the state, the work of the
 applied torques, of friction and of the end-effector wrench, so that
@@ -32,8 +32,8 @@ import time
 import numpy as np
 
 from .scene import INTEGRATORS
-from ..core.dynamics import (inverse_dynamics, jacobian, link_poses,
-                             mass_matrix, solve_mass_matrix, Workspace)
+from ..core.dynamics import jacobian, link_poses
+from ..core.effects import EffectDynamics
 
 
 def pd_torque(scene, q_d, qd_d, q, qd):
@@ -41,61 +41,19 @@ def pd_torque(scene, q_d, qd_d, q, qd):
     return scene.kp * (q_d - q) + scene.kd * (qd_d - qd)
 
 
-def friction_torque(scene, qd):
-    """Friction torque the joints lose: viscous qd + Coulomb sign(qd)."""
-    return scene.viscous * qd + scene.coulomb * np.sign(qd)
-
-
-class SceneDynamics:
+class SceneDynamics(EffectDynamics):
     """
-    The dynamics of one scene's effects, with a reusable workspace.
+    A scene's :class:`EffectDynamics`, with its energy and power.
 
-    Every method takes the end-effector wrench as an argument (None:
-    none), in ``frame`` 'base' or 'end_effector'; it is ignored, and no
-    Jacobian is formed, unless the scene has the wrench effect.  Where the
-    wrench comes from (the scene's schedule, :meth:`Scene.wrench_at`, or
-    a live topic) is the caller's business.
+    Its effects, friction and rotor inertia are the scene's; the wrench is
+    an argument of every method, as for the base class (the scene's own
+    is :meth:`Scene.wrench_at`).
     """
 
     def __init__(self, scene):
+        super().__init__(scene.model, scene.effects, scene.viscous,
+                         scene.coulomb, scene.armature)
         self.scene = scene
-        self.model = scene.model
-        self.effects = scene.effects
-        self.ws = Workspace(scene.model)
-        n = scene.model.n
-        self._D = np.zeros((n, n))
-
-    def friction(self, qd):
-        """Friction torque the joints lose (:func:`friction_torque`)."""
-        return friction_torque(self.scene, qd)
-
-    def torques(self, q, qd, qdd, wrench=None, frame='base', out=None):
-        """Inverse dynamics with exactly the scene's effects; qdd may be None."""
-        eff = self.effects
-        if not eff.wrench:
-            wrench = None
-        tau = inverse_dynamics(self.model, q, qd, qdd, wrench, frame,
-                               gravity=eff.gravity,
-                               velocity_products=eff.velocity_products,
-                               ws=self.ws, out=out)
-        if eff.armature and qdd is not None:
-            tau += self.scene.armature * qdd
-        if eff.friction:
-            tau += self.friction(qd)
-        return tau
-
-    def mass_matrix(self, q, out=None):
-        """D(q), plus the rotor inertia on its diagonal with armature."""
-        D = mass_matrix(self.model, q, ws=self.ws, out=out)
-        if self.effects.armature:
-            D.flat[::D.shape[0] + 1] += self.scene.armature
-        return D
-
-    def accelerations(self, q, qd, tau, wrench=None, frame='base'):
-        """Forward dynamics: qdd for applied torques ``tau``."""
-        bias = self.torques(q, qd, None, wrench, frame)
-        D = self.mass_matrix(q, out=self._D)
-        return solve_mass_matrix(self.model, q, D, tau - bias, ws=self.ws)
 
     def energy(self, q, qd):
         """Kinetic (with rotor inertia) plus gravitational potential."""
