@@ -54,6 +54,28 @@ def id_node_cmd(params='puma560.yaml', *extra):
     return base + ['--ros-args', *files, *extra]
 
 
+def joint_state(names, position, velocity, stamp):
+    """Return a sensor_msgs/JointState of these values."""
+    from sensor_msgs.msg import JointState
+    msg = JointState()
+    msg.header.stamp = stamp
+    msg.name = list(names)
+    msg.position = [float(x) for x in position]
+    msg.velocity = [float(x) for x in velocity]
+    return msg
+
+
+def wrench(frame_id, values, stamp):
+    """Return a geometry_msgs/WrenchStamped: force, then torque."""
+    from geometry_msgs.msg import WrenchStamped
+    msg = WrenchStamped()
+    msg.header.frame_id = frame_id
+    msg.header.stamp = stamp
+    f, n = msg.wrench.force, msg.wrench.torque
+    f.x, f.y, f.z, n.x, n.y, n.z = (float(v) for v in values)
+    return msg
+
+
 class Probe:
     """A test-side rclpy node in its own context: publish, collect, call."""
 
@@ -114,6 +136,26 @@ class Probe:
         self.executor.shutdown()
         self.node.destroy_node()
         self.rclpy.try_shutdown(context=self.context)
+
+    def keyed_stamp(self, seq, offset_s=0.0):
+        """
+        Return a stamp ``offset_s`` from now that ends in ``seq % 1000`` ns.
+
+        The node copies a joint state's stamp onto its torques, so the
+        stamp is the key that finds the answer to one message.
+        """
+        from builtin_interfaces.msg import Time
+        ns = self.node.get_clock().now().nanoseconds + int(offset_s * 1e9)
+        ns = (ns // 1000) * 1000 + seq % 1000
+        return Time(sec=ns // 10**9, nanosec=ns % 10**9)
+
+    def answer(self, torques, stamp, wait):
+        """Return the message of ``torques`` stamped ``stamp``, or None."""
+        def match():
+            return next((t for t in torques if t.header.stamp == stamp),
+                        None)
+        self.spin_until(lambda: match() is not None, wait)
+        return match()
 
     def next_counters(self, diagnostics, timeout=5.0):
         """

@@ -35,8 +35,8 @@ from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (inverse_dynamics, jacobian,  # noqa: E402
                                    load_robot)
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -81,35 +81,17 @@ class Graph:
 
     def stamp(self, offset_s=0.0):
         self.seq += 1
-        ns = self.probe.node.get_clock().now().nanoseconds
-        ns += int(offset_s * 1e9)
-        ns = (ns // 1000) * 1000 + self.seq % 1000
-        from builtin_interfaces.msg import Time
-        return Time(sec=ns // 10**9, nanosec=ns % 10**9)
+        return self.probe.keyed_stamp(self.seq, offset_s)
 
     def send(self, names, q, qd, stamp=None, wait=3.0):
-        msg = JointState()
-        msg.header.stamp = stamp if stamp is not None else self.stamp()
-        msg.name = list(names)
-        msg.position = [float(x) for x in q]
-        msg.velocity = [float(x) for x in qd]
-        key = (msg.header.stamp.sec, msg.header.stamp.nanosec)
-        self.js.publish(msg)
-        found = self.probe.spin_until(
-            lambda: any((t.header.stamp.sec, t.header.stamp.nanosec) == key
-                        for t in self.torques), wait)
-        if not found:
-            return None
-        return np.array(next(t for t in self.torques if (
-            t.header.stamp.sec, t.header.stamp.nanosec) == key).effort)
+        stamp = stamp if stamp is not None else self.stamp()
+        self.js.publish(joint_state(names, q, qd, stamp))
+        out = self.probe.answer(self.torques, stamp, wait)
+        return None if out is None else np.array(out.effort)
 
     def wrench(self, frame, values):
-        msg = WrenchStamped()
-        msg.header.frame_id = frame
-        msg.header.stamp = self.probe.node.get_clock().now().to_msg()
-        f, n = msg.wrench.force, msg.wrench.torque
-        f.x, f.y, f.z, n.x, n.y, n.z = (float(v) for v in values)
-        self.wr.publish(msg)
+        now = self.probe.node.get_clock().now().to_msg()
+        self.wr.publish(wrench(frame, values, now))
         self.probe.spin_for(0.2)
 
     def counters(self):

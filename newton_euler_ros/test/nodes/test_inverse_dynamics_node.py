@@ -37,8 +37,8 @@ from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (coriolis_matrix, gravity_torques,  # noqa: E402
                                    inverse_dynamics, load_robot,
                                    mass_matrix)
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe, ros_env)
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe, ros_env, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -101,17 +101,15 @@ class Graph:
         Return (torque_command data, torques msg), or None if no output.
         """
         self.seq += 1
-        msg = JointState()
-        stamp = self.now().to_msg()
-        stamp.nanosec = (stamp.nanosec // 1000) * 1000 + self.seq % 1000
-        msg.header.stamp = stamp
+        stamp = self.probe.keyed_stamp(self.seq)
         order = [5, 2, 0, 4, 1, 3]
-        msg.name = names if names is not None else (
-            ['gripper'] + [f'joint{k + 1}' for k in order])
-        msg.position = position if position is not None else (
-            [0.7] + [float(q[k]) for k in order])
-        msg.velocity = velocity if velocity is not None else (
-            [0.0] + [float(qd[k]) for k in order])
+        msg = joint_state(
+            names if names is not None else (
+                ['gripper'] + [f'joint{k + 1}' for k in order]),
+            position if position is not None else (
+                [0.7] + [q[k] for k in order]),
+            velocity if velocity is not None else (
+                [0.0] + [qd[k] for k in order]), stamp)
         before = len(self.cmds)
         self.js.publish(msg)
 
@@ -124,14 +122,8 @@ class Graph:
         return np.array(self.cmds[-1].data), tq
 
     def send_wrench(self, frame, values, age=0.0):
-        msg = WrenchStamped()
-        msg.header.frame_id = frame
-        t = self.now().nanoseconds * 1e-9 - age
-        msg.header.stamp.sec = int(t)
-        msg.header.stamp.nanosec = int((t - int(t)) * 1e9)
-        f, n = msg.wrench.force, msg.wrench.torque
-        f.x, f.y, f.z, n.x, n.y, n.z = (float(v) for v in values)
-        self.wr.publish(msg)
+        self.wr.publish(wrench(frame, values,
+                               self.probe.keyed_stamp(0, -age)))
         self.probe.spin_for(0.3)
 
     def counters(self):

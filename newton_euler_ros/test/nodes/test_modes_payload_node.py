@@ -39,8 +39,8 @@ from newton_euler_ros.core import (end_effector_pose,  # noqa: E402
 from rcl_interfaces.srv import (SetParameters,  # noqa: E402
                                 SetParametersAtomically)
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
                                  JointTrajectoryPoint)
@@ -87,18 +87,11 @@ class Graph:
 
     def send(self, names, q, qd):
         self.seq += 1
-        msg = JointState()
-        stamp = self.probe.node.get_clock().now().to_msg()
-        stamp.nanosec = (stamp.nanosec // 1000) * 1000 + self.seq % 1000
-        msg.header.stamp = stamp
-        msg.name = list(names)
-        msg.position = [float(x) for x in q]
-        msg.velocity = [float(x) for x in qd]
-        self.js.publish(msg)
-        assert self.probe.spin_until(
-            lambda: any(t.header.stamp == stamp for t in self.torques), 5.0)
-        return np.array(next(t for t in self.torques
-                             if t.header.stamp == stamp).effort)
+        stamp = self.probe.keyed_stamp(self.seq)
+        self.js.publish(joint_state(names, q, qd, stamp))
+        out = self.probe.answer(self.torques, stamp, 5.0)
+        assert out is not None, self.node.log()
+        return np.array(out.effort)
 
     def set_params(self, atomically=False, **values):
         """Set parameters (``payload__mass`` for payload.mass)."""

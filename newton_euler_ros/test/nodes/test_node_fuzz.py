@@ -39,7 +39,7 @@ from newton_euler_ros.core import (DynamicsInputError,  # noqa: E402
                                    inverse_dynamics, load_robot)
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
 from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+                         Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -196,12 +196,9 @@ class Graph:
         self.sent['joint_states'] += 1
 
     def publish_wrench(self, frame, values, stamp):
-        msg = WrenchStamped()
-        msg.header.frame_id = frame
-        msg.header.stamp.sec, msg.header.stamp.nanosec = stamp
-        f, n = msg.wrench.force, msg.wrench.torque
-        f.x, f.y, f.z, n.x, n.y, n.z = (float(v) for v in values)
-        self.wr.publish(msg)
+        from builtin_interfaces.msg import Time
+        self.wr.publish(wrench(frame, values,
+                               Time(sec=stamp[0], nanosec=stamp[1])))
         self.sent['wrenches'] += 1
 
     def counters(self):

@@ -40,8 +40,8 @@ from newton_euler_ros.core.model import rpy_matrix  # noqa: E402
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
@@ -115,19 +115,9 @@ class Graph:
 
     def send(self, names, q, qd, wait=5.0):
         self.seq += 1
-        msg = JointState()
-        stamp = self.probe.node.get_clock().now().to_msg()
-        stamp.nanosec = (stamp.nanosec // 1000) * 1000 + self.seq % 1000
-        msg.header.stamp = stamp
-        msg.name = list(names)
-        msg.position = [float(x) for x in q]
-        msg.velocity = [float(x) for x in qd]
-        self.js.publish(msg)
-        if not self.probe.spin_until(
-                lambda: any(t.header.stamp == stamp for t in self.torques),
-                wait):
-            return None
-        return next(t for t in self.torques if t.header.stamp == stamp)
+        stamp = self.probe.keyed_stamp(self.seq)
+        self.js.publish(joint_state(names, q, qd, stamp))
+        return self.probe.answer(self.torques, stamp, wait)
 
     def wait_for_model(self, names, q, qd, timeout=60.0):
         """Send states until the node answers for this joint set."""
@@ -140,12 +130,8 @@ class Graph:
                              + self.node.log())
 
     def wrench(self, frame_id, values):
-        msg = WrenchStamped()
-        msg.header.frame_id = frame_id
-        msg.header.stamp = self.probe.node.get_clock().now().to_msg()
-        f, n = msg.wrench.force, msg.wrench.torque
-        f.x, f.y, f.z, n.x, n.y, n.z = (float(v) for v in values)
-        self.wr.publish(msg)
+        now = self.probe.node.get_clock().now().to_msg()
+        self.wr.publish(wrench(frame_id, values, now))
         self.probe.spin_for(0.2)
 
     def close(self):
