@@ -132,20 +132,21 @@ class HighPrecisionModel:
             raise _bad_method(method)
         with mpmath.workdps(self.dps):
             ws = np.empty((n, K.W_WIDTH), dtype=object)
-            scratch = np.empty((3, n), dtype=object)
             D = np.empty((n, n), dtype=object)
             qv = self._vec(q, n)
             if method == 'crba':
                 _MP.mass_matrix_crba(self.links, self.frames, qv, ws, D)
                 return D
-            _MP.joint_trig(self.links, self.frames, qv, ws)
-            zero = mpmath.mpf(0)
-            for i in range(3):
-                for k in range(n):
-                    scratch[i, k] = zero
-            _MP._unit_columns(self.links, self.frames, qv, False, ws,
-                              scratch, D)
-        return D
+            return self._unit_columns(qv, qv, False, ws, D)
+
+    def _unit_columns(self, q, qd, coriolis, ws, M):
+        """Fill M column by column, one recursion each (D, or C)."""
+        n = self.model.n
+        _MP.joint_trig(self.links, self.frames, q, ws)
+        scratch = np.full((3, n), mpmath.mpf(0), dtype=object)
+        _MP._unit_columns(self.links, self.frames, qd, coriolis, ws,
+                          scratch, M)
+        return M
 
     def coriolis_matrix(self, q, qd, method='newton_euler'):
         """
@@ -167,15 +168,7 @@ class HighPrecisionModel:
                 _MP.coriolis_matrix_composite(self.links, self.frames, qv,
                                               qdv, ws, cw, C)
                 return C
-            scratch = np.empty((3, n), dtype=object)
-            _MP.joint_trig(self.links, self.frames, qv, ws)
-            zero = mpmath.mpf(0)
-            for i in range(3):
-                for k in range(n):
-                    scratch[i, k] = zero
-            _MP._unit_columns(self.links, self.frames, qdv, True, ws,
-                              scratch, C)
-        return C
+            return self._unit_columns(qv, qdv, True, ws, C)
 
     def forward_dynamics(self, q, qd, tau, wrench=None, wrench_frame='base',
                          method='aba'):
