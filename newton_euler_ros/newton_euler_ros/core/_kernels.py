@@ -1274,7 +1274,7 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
 # the model packed into one array (``pack``), the switches as one integer
 # (``flags``), checks every size against the model (numba does not check
 # bounds) and every input for finiteness, and returns a status code.  Few
-# arguments, because numba's dispatcher costs about 50 ns per argument.
+# arguments, because numba's dispatcher costs about 40 ns per argument.
 #
 # They are compiled without numba's reference-counting runtime (NRT,
 # option ``_nrt``): they allocate nothing and keep no array past the call,
