@@ -252,30 +252,36 @@ def naive_mass_matrix(model, q):
 
 
 def _dispatch_probes():
-    """Do-nothing njit functions with the entry points' argument lists."""
-    from numba import njit
+    """
+    Do-nothing njit functions with the entry points' argument lists.
 
-    @njit(cache=False)
+    Compiled with the entry points' options (``K.ENTRY``, not cached), so
+    that they pay the same dispatch as the kernels do.
+    """
+    from numba import njit
+    options = dict(K.ENTRY, cache=False)
+
+    @njit(**options)
     def noop0():
         return -1
 
-    @njit(cache=False)
+    @njit(**options)
     def noop1(x):
         return -1
 
-    @njit(cache=False)
+    @njit(**options)
     def noop4(P, q, ws, out):
         return -1
 
-    @njit(cache=False)
+    @njit(**options)
     def noop_tau(P, q, qd, qdd, wrench, flags, ws, tau):
         return -1
 
-    @njit(cache=False)
+    @njit(**options)
     def noop_c(P, q, qd, composite, ws, cw, scratch, C):
         return -1
 
-    @njit(cache=False)
+    @njit(**options)
     def noop_fd(P, q, qd, tau, wrench, flags, ws, aw, qdd):
         return -1
 

@@ -97,10 +97,12 @@ def _strict(name, kernel, *argtypes):
 
     The dispatcher is compiled for ``argtypes`` only and compiles nothing
     else: other argument types raise TypeError at once, which the callers
-    take as the cue to convert their arguments.
+    take as the cue to convert their arguments.  It takes the entry
+    points' options (``_kernels.ENTRY``): numba's cache does not tell
+    compilations of one function with other options apart.
     """
     def load(*args):
-        strict = njit(types.int64(*argtypes), cache=True)(kernel.py_func)
+        strict = njit(types.int64(*argtypes), **K.ENTRY)(kernel.py_func)
         globals()[name] = strict
         return strict(*args)
     return load
