@@ -179,6 +179,26 @@ def _link_geometry(links, frames, j, ws):
 
 
 @njit(cache=True, inline='always')
+def _placement(links, frames, j, ws):
+    """Return R, p of kernel frame j in j-1 (``_link_geometry``), stored."""
+    R, p = _link_geometry(links, frames, j, ws)
+    for k in range(9):
+        ws[j, W_R + k] = R[k]
+    for k in range(3):
+        ws[j, W_P + k] = p[k]
+    return R, p
+
+
+@njit(cache=True, inline='always')
+def _link_inertia(links, j):
+    """Return link j's rotational inertia about its com, row-major 3x3."""
+    k = L_INERTIA
+    return (links[j, k], links[j, k + 1], links[j, k + 2],
+            links[j, k + 3], links[j, k + 4], links[j, k + 5],
+            links[j, k + 6], links[j, k + 7], links[j, k + 8])
+
+
+@njit(cache=True, inline='always')
 def _stored_placement(ws, j):
     """Return R, p of kernel frame j in j-1 as a pass stored them in ws."""
     R = (ws[j, W_R], ws[j, W_R + 1], ws[j, W_R + 2],
@@ -279,7 +299,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
     # from link j-1's w, r, al, ae (frame j-1 axes) to link j's (frame j
     # axes); link j's net force m a_c and moment about its com into ws
     for j in range(n):
-        R, p = _link_geometry(links, frames, j, ws)
+        R, p = _placement(links, frames, j, ws)
         # acceleration of the new origin O_j, still in frame j-1 axes
         t = _cross(al[0], al[1], al[2], p[0], p[1], p[2])
         ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
@@ -324,10 +344,7 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         ws[j, W_F + 1] = m * ac[1]
         ws[j, W_F + 2] = m * ac[2]
         # Euler's equation about the com
-        k = L_INERTIA
-        Ic = (links[j, k], links[j, k + 1], links[j, k + 2],
-              links[j, k + 3], links[j, k + 4], links[j, k + 5],
-              links[j, k + 6], links[j, k + 7], links[j, k + 8])
+        Ic = _link_inertia(links, j)
         Ia = _rot(Ic, al[0], al[1], al[2])
         Nn = Ia
         if velocity_on:
@@ -343,10 +360,6 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         ws[j, W_N] = Nn[0]
         ws[j, W_N + 1] = Nn[1]
         ws[j, W_N + 2] = Nn[2]
-        for k in range(9):
-            ws[j, W_R + k] = R[k]
-        for k in range(3):
-            ws[j, W_P + k] = p[k]
         if wrench_mode == WRENCH_BASE:
             Racc = _matmul(Racc, R)
 
@@ -566,11 +579,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
     half = frames[F_CONST, C_HALF]
     joint_trig(links, frames, q, ws)
     for j in range(n):
-        R, p = _link_geometry(links, frames, j, ws)
-        for k in range(9):
-            ws[j, W_R + k] = R[k]
-        for k in range(3):
-            ws[j, W_P + k] = p[k]
+        R, p = _placement(links, frames, j, ws)
     M = zero
     h = (zero, zero, zero)
     Io = (zero, zero, zero, zero, zero, zero)
@@ -817,11 +826,7 @@ def _body_inertia(links, j, R, o, M, row, col):
     m = links[j, L_MASS]
     c = _rot(R, links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2])
     c = (o[0] + c[0], o[1] + c[1], o[2] + c[2])
-    k = L_INERTIA
-    Ic = (links[j, k], links[j, k + 1], links[j, k + 2],
-          links[j, k + 3], links[j, k + 4], links[j, k + 5],
-          links[j, k + 6], links[j, k + 7], links[j, k + 8])
-    Ic = _matmul(_matmul(R, Ic), _transpose(R))
+    Ic = _matmul(_matmul(R, _link_inertia(links, j)), _transpose(R))
     mc = (m * c[0], m * c[1], m * c[2])
     cc = c[0] * mc[0] + c[1] * mc[1] + c[2] * mc[2]
     zero = m - m
@@ -934,11 +939,7 @@ def _aba_forward_velocities(links, frames, qd, wrench, velocity_on,
     ident = (one, zero, zero, zero, one, zero, zero, zero, one)
     origin = (zero, zero, zero)
     for j in range(n):
-        R, p = _link_geometry(links, frames, j, ws)
-        for k in range(9):
-            ws[j, W_R + k] = R[k]
-        for k in range(3):
-            ws[j, W_P + k] = p[k]
+        R, p = _placement(links, frames, j, ws)
         if wrench_mode == WRENCH_BASE:
             Racc = _matmul(Racc, R)
         _body_inertia(links, j, ident, origin, aw, j, A_IA)
