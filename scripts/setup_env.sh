@@ -64,7 +64,8 @@ pip_filtered() {
   return "$rc"
 }
 
-# Hash of the given files/dirs: paths (relative to the repo, so two clones
+# Hash of the given files/dirs (links followed, so a scratch root of links
+# to this one, as the docs test makes, hashes the same): paths (relative to the repo, so two clones
 # agree) and contents, in a stable order.  Missing paths hash as "missing",
 # so creating them later changes the hash.
 hash_inputs() {
@@ -73,7 +74,7 @@ hash_inputs() {
     for p in "$@"; do
       p="${p#"$ROOT"/}"
       if [[ -d "$p" ]]; then
-        find "$p" -type f ! -name '*.pyc' ! -path '*/__pycache__/*' \
+        find -L "$p" -type f ! -name '*.pyc' ! -path '*/__pycache__/*' \
           ! -path '*.egg-info/*' -print0 | LC_ALL=C sort -z \
           | xargs -0 -r sha256sum
       elif [[ -f "$p" ]]; then
