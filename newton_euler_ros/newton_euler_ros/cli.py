@@ -38,7 +38,8 @@ import sys
 import numpy as np
 
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
-                   inverse_dynamics, jacobian, mass_matrix, NewtonEulerError)
+                   inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
+                   RobotFileError)
 from .core.robot_file import bundled_robots, Note, read_text, to_number
 
 EXIT_USAGE = 2
@@ -152,7 +153,14 @@ def _warn(found):
 
 
 def _load(args):
-    return inspect_robot(args.robot, base=args.base, tip=args.tip)
+    try:
+        return inspect_robot(args.robot, base=args.base, tip=args.tip)
+    except RobotFileError as exc:
+        # a mistyped --base/--tip is a usage error (the message names the
+        # closest links)
+        if 'link' in str(exc) and 'is not in the URDF' in str(exc):
+            raise CliError(str(exc)) from None
+        raise
 
 
 def format_table(model, result, q, qd, qdd, wrench, wrench_frame):

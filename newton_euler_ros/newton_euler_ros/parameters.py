@@ -24,10 +24,16 @@ parameters from the same :class:`ParameterSpec` list
 (:func:`..nodes.common.declare_parameters`).
 
     python -m newton_euler_ros.parameters --markdown [NODE]
+
+It also writes each node's ``--help`` (:func:`node_help`): the node's
+module docstring (what it does, its topics and services) and its
+parameters, without importing ROS.
 """
+import ast
 import math
 import os
 import sys
+import textwrap
 
 import yaml
 
@@ -156,6 +162,62 @@ def markdown_table(specs):
         lines.append(f'| `{s.name}` | {s.type} | `{default}` | '
                      f'{"yes" if s.read_only else "no"} | {desc} |')
     return '\n'.join(lines)
+
+
+def help_requested(argv):
+    """Return True when ``-h`` or ``--help`` comes before ``--ros-args``."""
+    for token in argv:
+        if token in ('--ros-args', '--'):
+            return False
+        if token in ('-h', '--help'):
+            return True
+    return False
+
+
+def _default_text(spec):
+    default = yaml.safe_dump(spec.default, default_flow_style=True,
+                             width=1000).strip()
+    return default[:-3].strip() if default.endswith('...') else default
+
+
+def _rule_text(rule, args):
+    if rule == 'one_of<>':
+        return 'one of ' + ', '.join(repr(v) for v in args[0])
+    return f'{rule[:-2]} {", ".join(map(str, args))}' if args else rule[:-2]
+
+
+def node_help(node_name):
+    """
+    Return the ``--help`` text of a node: what it does, topics, parameters.
+
+    The description and the topic lists are the node module's docstring
+    (read from its source: nothing is imported, ROS does not start); the
+    parameters come from the node's schema.
+    """
+    source = os.path.join(HERE, 'nodes', f'{node_name}.py')
+    with open(source, encoding='utf-8') as fh:
+        doc = ast.get_docstring(ast.parse(fh.read())) or node_name
+    lines = [f'usage: {node_name} [-h] [--ros-args [-p NAME:=VALUE]... '
+             f'[--params-file FILE]... [-r FROM:=TO]...]', '', doc, '',
+             'Parameters (-p NAME:=VALUE, or --params-file FILE with a',
+             f'section {node_name}: or /**:; an unknown name stops the '
+             f'node):']
+    for spec in load_specs(node_name):
+        flags = ', read-only' if spec.read_only else ''
+        lines.append(f'  {spec.name} ({spec.type}, default '
+                     f'{_default_text(spec)}{flags})')
+        rules = '; '.join(_rule_text(k, v)
+                          for k, v in spec.validation.items())
+        text = spec.description + (f' Validation: {rules}.' if rules else '')
+        lines += textwrap.wrap(text, 76, initial_indent='      ',
+                               subsequent_indent='      ')
+    return '\n'.join(lines) + '\n'
+
+
+def print_help(node_name):
+    """Print :func:`node_help` on stdout."""
+    sys.stdout.write(node_help(node_name))
+    sys.stdout.flush()
 
 
 if __name__ == '__main__':

@@ -19,7 +19,8 @@ Closed-loop demo: simulator, inverse dynamics and a tracking controller.
                                     [--out DIR] [--quick]
 
 Runs the scene twice, each time as three ROS processes in a domain of
-its own (discovery on localhost): robot_sim_node, inverse_dynamics_node
+its own (ROS_DOMAIN_ID and the next id when it is set, else two ids from
+1 + pid % 100; discovery on localhost): robot_sim_node, inverse_dynamics_node
 (desired accelerations from the controller's reference) and
 tracking_controller_node, once with the feedforward and once with PD
 alone.  A probe in this process records joint states and commands.  The
@@ -41,7 +42,7 @@ import warnings
 from newton_euler_ros.graph import CONTROLLER_REMAPS, ID, ros_args, SIM
 import numpy as np
 
-from .processes import ChildProcess
+from .processes import ChildProcess, first_domain
 
 SCENE = 'puma_payload_press'
 QUICK_DURATION = 1.0
@@ -52,12 +53,14 @@ class DemoError(Exception):
     """The demo could not run to completion."""
 
 
-def base_domain():
-    """Return the first domain id to use (from ROS_DOMAIN_ID, else pid)."""
-    value = os.environ.get('ROS_DOMAIN_ID', '')
-    if value.isdigit():
-        return int(value)
-    return 1 + os.getpid() % 100
+def base_domain(count=2):
+    """
+    Return the first of ``count`` domain ids, one per run.
+
+    ROS_DOMAIN_ID when set, else 1 + pid % 100 (runs started side by side
+    rarely share a domain); ValueError for an unusable ROS_DOMAIN_ID.
+    """
+    return first_domain(1 + os.getpid() % 100, count)
 
 
 class Child(ChildProcess):
@@ -494,13 +497,17 @@ def main(argv=None):
     out = os.path.abspath(args.out)
     log_dir = os.path.join(out, 'logs')
     os.makedirs(log_dir, exist_ok=True)
-    base = base_domain()
+    try:
+        base = base_domain()
+    except ValueError as exc:
+        print(f'demo: {exc}', file=sys.stderr)
+        return 2
     started = time.monotonic()
     runs, rms = {}, {}
     try:
         for k, (key, feedforward) in enumerate((('feedforward', True),
                                                 ('pd', False))):
-            domain = 1 + (base - 1 + k) % 100
+            domain = base + k
             runs[key] = run_graph(scene_arg, key, feedforward, duration, domain,
                                   log_dir)
             if len(runs[key]['t']) < 2:

@@ -266,13 +266,17 @@ def main(argv=None):
     out = os.path.abspath(args.out)
     log_dir = os.path.join(out, 'logs')
     os.makedirs(log_dir, exist_ok=True)
-    base = base_domain()
+    try:
+        base = base_domain()
+    except ValueError as exc:
+        print(f'demo_pick: {exc}', file=sys.stderr)
+        return 2
     runs = {}
     started = time.monotonic()
     try:
         for k, (key, update) in enumerate((('updated', True),
                                            ('stale', False))):
-            domain = 1 + (base - 1 + k) % 100
+            domain = base + k
             print(f'[{key}] running in domain {domain}', flush=True)
             runs[key] = run(key, update, duration, domain, log_dir, model,
                             scene.q0)

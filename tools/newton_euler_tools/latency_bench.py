@@ -18,7 +18,9 @@ Measure latency: joint state in, torques out, through the real ROS graph.
     python -m newton_euler_tools.latency_bench [--duration S] [--quick]
                                              [--json PATH] [--rate HZ]
 
-Four phases, each in a ROS domain of its own, on loopback discovery:
+Four phases, each in a ROS domain of its own (``--domain`` and the next
+three ids; default ROS_DOMAIN_ID when set, else 64), on loopback
+discovery:
 
 1. **inverse_dynamics_node** (the node under test) is started as its own
    process (``inverse_dynamics_node --ros-args --params-file
@@ -93,7 +95,7 @@ import time
 
 import numpy as np
 
-from .processes import ChildProcess, prctl as _prctl
+from .processes import ChildProcess, first_domain, prctl as _prctl
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO_DIR = os.path.dirname(os.path.dirname(PACKAGE_DIR))
@@ -731,9 +733,10 @@ def main(argv=None):
                         help='write every figure to this JSON file')
     parser.add_argument('--rate', type=float, default=1000.0,
                         help='publishing rate, Hz (default 1000)')
-    parser.add_argument('--domain', type=int, default=DEFAULT_DOMAIN,
+    parser.add_argument('--domain', type=int, default=None,
                         help='ROS domain of the first phase; the others '
-                             f'use the next ids (default {DEFAULT_DOMAIN})')
+                             'use the next ids (default ROS_DOMAIN_ID when '
+                             f'set, else {DEFAULT_DOMAIN})')
     parser.add_argument('--seed', type=int, default=1,
                         help='seed of the random walk (default 1)')
     parser.add_argument('--startup-timeout', type=float, default=60.0,
@@ -781,6 +784,11 @@ def main(argv=None):
         args.duration = 2.0
     if args.duration <= 0 or args.rate <= 0:
         parser.error('--duration and --rate must be > 0')
+    if args.domain is None:
+        try:
+            args.domain = first_domain(DEFAULT_DOMAIN, 4)
+        except ValueError as exc:
+            parser.error(str(exc))
     if not 0 <= args.domain <= 229:
         parser.error('--domain must be in 0..229')
 

@@ -16,7 +16,8 @@
 Child ROS 2 processes for the demo, the benchmarks and the tests.
 
 Each child gets this process's environment plus its own ROS_DOMAIN_ID and
-localhost-only discovery.  LD_LIBRARY_PATH is inherited untouched: the
+localhost-only discovery; :func:`first_domain` makes a tool start from
+the user's ROS_DOMAIN_ID when it is set.  LD_LIBRARY_PATH is inherited untouched: the
 ROS wheels' bootstrap set it, and a child with a replaced one cannot
 import rclpy.
 """
@@ -24,6 +25,28 @@ import ctypes
 import os
 import signal
 import subprocess
+
+
+MAX_DOMAIN = 232        # the highest ROS 2 domain id
+
+
+def first_domain(default, count=1):
+    """
+    Return the first of ``count`` consecutive ROS domain ids for a tool.
+
+    ``ROS_DOMAIN_ID`` when it is set (the tool uses it and the next
+    ``count - 1`` ids), else ``default``.  A value that is not an integer,
+    or ids beyond :data:`MAX_DOMAIN`, raise ValueError (one line).
+    """
+    value = os.environ.get('ROS_DOMAIN_ID', '').strip()
+    if not value:
+        return default
+    if not value.isdigit() or int(value) + count - 1 > MAX_DOMAIN:
+        raise ValueError(
+            f'ROS_DOMAIN_ID={value[:40]!r}: this tool uses {count} '
+            f'consecutive domain ids from it, so it must be an integer in '
+            f'0..{MAX_DOMAIN - count + 1}')
+    return int(value)
 
 
 def ros_env(domain):

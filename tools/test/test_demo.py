@@ -50,6 +50,10 @@ def test_quick_demo(tmp_path):
         env=ros_env(domain_id(61)), capture_output=True, text=True,
         timeout=180)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    # ROS_DOMAIN_ID is respected: this run's id, then the next one
+    for label, domain in (('feedforward', domain_id(61)),
+                          ('pd', domain_id(61) + 1)):
+        assert f'[{label}] nodes up in domain {domain};' in proc.stdout
     assert 'all nodes exited 0' in proc.stdout
     assert proc.stdout.count('all nodes exited 0') == 2
     for name in PLOTS + ('summary.md',):
@@ -92,6 +96,8 @@ def test_quick_pick_and_place_demo(tmp_path):
         env=ros_env(domain_id(71)), capture_output=True, text=True,
         timeout=240)
     assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert f'[updated] running in domain {domain_id(71)}\n' in proc.stdout
+    assert f'[stale] running in domain {domain_id(71) + 1}\n' in proc.stdout
     result = json.loads((out / 'summary.json').read_text())
     before, after = result['rms_before_pick'], result['rms_carrying']
     # the same plan and plant until the pick: the same tracking

@@ -36,10 +36,12 @@ def test_latency_benchmark_runs(tmp_path):
     out = tmp_path / 'latency.json'
     proc = subprocess.run(
         [sys.executable, '-m', 'newton_euler_tools.latency_bench', '--quick',
-         '--domain', str(domain_id(53)), '--json', str(out)],
+         '--json', str(out)],
         env=ros_env(domain_id(53)), capture_output=True, text=True,
         timeout=240)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    # no --domain: the phases use ROS_DOMAIN_ID and the next three ids
+    assert json.loads(out.read_text())['domain'] == domain_id(53)
     assert 'p99 < 1 ms' in proc.stdout
     assert 'executor trade-off: ' in proc.stdout
     assert 'child exit codes after SIGINT: inverse_dynamics_node 0' in \

@@ -493,11 +493,14 @@ def load_robot(name_or_path, base=None, tip=None):
 
     A ``.urdf`` file gives the chain from ``base`` to ``tip`` (defaults:
     the root link, and the single leaf below it); see
-    :mod:`newton_euler_ros.core.urdf`.  Warnings (e.g. inertias that break
-    the triangle inequality) are issued as :class:`RobotFileWarning`;
-    errors raise :class:`RobotFileError`.
+    :mod:`newton_euler_ros.core.urdf`.  Warnings are issued as
+    :class:`RobotFileWarning`; notes on data accepted as published (the
+    Puma 560's inertias that break the triangle inequality) are not: they
+    are in :func:`inspect_robot`'s list and ``newton-euler check``'s
+    output.  Errors raise :class:`RobotFileError`.
     """
     model, found, _ = inspect_robot(name_or_path, base=base, tip=tip)
     for message in found:
-        warnings.warn(message, RobotFileWarning, stacklevel=2)
+        if not isinstance(message, Note):
+            warnings.warn(message, RobotFileWarning, stacklevel=2)
     return model

@@ -32,7 +32,8 @@ What a URDF model means here (see the README, "Robots from URDF"):
   them: their own motion is not modelled.
 - ``<inertial>`` with its ``<origin xyz rpy>``: the inertia is rotated into
   the link frame (I_link = R I R^T, the centre of mass at xyz).  A link
-  without ``<inertial>`` is massless (one warning lists them).
+  without ``<inertial>`` is massless (one warning lists them; not for
+  frames on fixed joints such as ``tool0``).
 - The end effector is the tip link's frame; gravity is [0, 0, -9.81] in
   the base link's axes unless given.
 
@@ -45,6 +46,7 @@ read.  Every error is a :class:`~newton_euler_ros.core.errors.RobotFileError`
 naming the source (the file, or ``robot_description``), the element and
 the attribute.
 """
+import difflib
 import math
 import os
 import xml.etree.ElementTree as ET  # noqa: N817 (only for ParseError)
@@ -471,8 +473,13 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     base = root if base is None else base
     for role, lname in (('base', base), ('tip', tip)):
         if lname is not None and lname not in links:
+            close = difflib.get_close_matches(str(lname), list(links), n=3,
+                                              cutoff=0.5)
+            hint = (' (closest: ' + ', '.join(map(repr, close)) + ')'
+                    if close else
+                    f' (links: {_short(", ".join(links), 300)})')
             raise RobotFileError(f'{label}: {role} link {_short(lname)!r} is '
-                                 f'not in the URDF')
+                                 f'not in the URDF{hint}')
     if tip is None:
         leaves = _leaves_below(links, joints, base)
         if len(leaves) != 1:
@@ -525,7 +532,10 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         inertia.append(inertia_k)
         carried.append(parts)
         for lname, _, via in parts:
-            if not links[lname].has_inertial:
+            # a massless link on a fixed joint is a frame (tool0, ee_link,
+            # flange): nothing to warn about
+            if not links[lname].has_inertial and not (
+                    via is not None and joints[via].kind == 'fixed'):
                 massless.append(lname)
             joint = joints[via] if via is not None else None
             if joint is not None and via not in chain_set \
@@ -551,12 +561,16 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         lname = joint.parent
         base_frames[lname] = T
     # ---- warnings ----
-    if lumped:
-        moved = [f'{v} ({kind})' for v, kind, *_ in lumped if kind != 'fixed']
+    # massless frames on fixed joints (ee_link, tool0) change nothing
+    told = [(v, kind) for v, kind in lumped if kind != 'fixed'
+            or links[joints[v].child].mass > 0.0
+            or links[joints[v].child].inertia.any()]
+    if told:
+        moved = [f'{v} ({kind})' for v, kind, *_ in told if kind != 'fixed']
         found.append(
             f'{label}: off-chain subtrees lumped rigidly into the chain at '
             f'their zero position (their motion is not modelled): joints '
-            f'{_short(", ".join(v for v, *_ in lumped), 400)}'
+            f'{_short(", ".join(v for v, *_ in told), 400)}'
             + (f'; moving ones locked: {_short(", ".join(moved), 300)}'
                if moved else ''))
     if massless:
@@ -610,15 +624,18 @@ def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):
     ``gravity`` is in the base link's axes (URDF does not carry it).
 
     Warnings are issued as
-    :class:`~newton_euler_ros.core.robot_file.RobotFileWarning`; errors
-    raise :class:`~newton_euler_ros.core.errors.RobotFileError`.
+    :class:`~newton_euler_ros.core.robot_file.RobotFileWarning` (notes on
+    data accepted as published are left to :func:`inspect_urdf` and
+    ``newton-euler check``); errors raise
+    :class:`~newton_euler_ros.core.errors.RobotFileError`.
     """
     import warnings
-    from .robot_file import RobotFileWarning
+    from .robot_file import Note, RobotFileWarning
     model, found, _ = inspect_urdf(text_or_path, base=base, tip=tip,
                                    gravity=gravity)
     for message in found:
-        warnings.warn(message, RobotFileWarning, stacklevel=2)
+        if not isinstance(message, Note):
+            warnings.warn(message, RobotFileWarning, stacklevel=2)
     return model
 
 

@@ -20,6 +20,11 @@ What every node of the package shares: parameters, QoS, and main().
 descriptions and read-only flags, and validates them: a wrong type or an
 invalid value is a :class:`ConfigurationError` (one line, exit status 2).
 
+A parameter override (``-p`` or a params file) that no declared
+parameter matches is a ConfigurationError too, naming the closest real
+parameter; a ``--params-file`` with no section for the node's name gets a
+warning naming the sections it has (its parameters then do not apply).
+
 ``run_node`` is the Jazzy-style main: init, build the node (a
 configuration error refuses to start with a one-line reason and exit
 status 2), spin until SIGINT/SIGTERM or shutdown, destroy, shut down;
@@ -36,7 +41,9 @@ EventsExecutor's ``spin()`` is avoided (in this rclpy build it busy-waits
 and ignores shutdown).
 """
 import array
+import difflib
 import os
+import re
 import signal
 import sys
 
@@ -49,7 +56,7 @@ from rclpy.parameter import Parameter
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rclpy.signals import SignalHandlerOptions
 
-from ..parameters import validate
+from ..parameters import help_requested, print_help, validate
 
 _PARAM_TYPES = {
     'string': Parameter.Type.STRING, 'double': Parameter.Type.DOUBLE,
@@ -98,6 +105,113 @@ def plain(value):
     return value
 
 
+# the command line run_node gave rclpy.init (None: not run by run_node)
+_PROCESS_ARGS = None
+# --ros-args options that take a value (the value is not an option)
+_ROS_VALUE_OPTIONS = {'-p', '--param', '-r', '--remap', '--params-file',
+                      '--log-level', '--log-config-file', '-e', '--enclave'}
+
+
+def params_files(args):
+    """Return the ``--params-file`` paths of a command line, in order."""
+    files = []
+    in_ros = False
+    tokens = iter(args or ())
+    for token in tokens:
+        if token == '--ros-args':
+            in_ros = True
+        elif token == '--':
+            in_ros = False
+        elif in_ros and token in _ROS_VALUE_OPTIONS:
+            value = next(tokens, None)
+            if token == '--params-file' and value is not None:
+                files.append(value)
+    return files
+
+
+def params_file_sections(data):
+    """
+    Return the node sections of a parsed params file, as written.
+
+    A section is the path of keys down to a ``ros__parameters`` mapping
+    (``node``, ``/ns/node``, ``/**``, or nested ``ns: node:`` keys).
+    """
+    sections = []
+
+    def walk(tree, path):
+        for key, value in tree.items():
+            if not isinstance(value, dict):
+                continue
+            if 'ros__parameters' in value:
+                sections.append('/'.join([*path, str(key)]))
+            walk({k: v for k, v in value.items()
+                  if k != 'ros__parameters'}, [*path, str(key)])
+    if isinstance(data, dict):
+        walk(data, [])
+    return sections
+
+
+def section_matches(section, fully_qualified_name):
+    """
+    Return True when a params-file section applies to a node.
+
+    ROS 2 rules: a name without a leading ``/`` gets one; ``*`` stands for
+    one name token, ``**`` for any number of them (``/**``: every node).
+    """
+    tokens = [t for t in section.strip('/').split('/') if t]
+    pattern = ''
+    for token in tokens:
+        if token == '**':
+            pattern += '(/[^/]+)*'
+        else:
+            pattern += '/' + '[^/]+'.join(
+                re.escape(part) for part in token.split('*'))
+    return re.fullmatch(pattern or '/', fully_qualified_name) is not None
+
+
+def _warn_foreign_params_files(node):
+    """Warn about params files without a section for this node."""
+    import yaml
+    fqn = node.get_fully_qualified_name()
+    for path in params_files(_PROCESS_ARGS):
+        try:
+            with open(path, encoding='utf-8') as fh:
+                data = yaml.safe_load(fh)
+        except (OSError, yaml.YAMLError, UnicodeDecodeError):
+            continue            # rcl has already said what is wrong
+        sections = params_file_sections(data)
+        if not any(section_matches(s, fqn) for s in sections):
+            node.get_logger().warning(
+                f'params file {path}: no section for this node ({fqn}); its '
+                f'sections: {", ".join(sections) or "none"}; none of its '
+                f'parameters apply (name a section {node.get_name()}: or '
+                f'/**:)')
+
+
+def check_overrides(node, specs):
+    """
+    Refuse parameter overrides that no parameter of ``specs`` matches.
+
+    rclpy drops an override (``-p`` or a params file) that is never
+    declared without a word; raise a ConfigurationError naming it and the
+    closest real parameter instead.  Also warns about params files that
+    have no section for this node.
+    """
+    _warn_foreign_params_files(node)
+    names = [spec.name for spec in specs]
+    overrides = getattr(node, '_parameter_overrides', None) or {}
+    unknown = [name for name in overrides
+               if name not in names and not node.has_parameter(name)]
+    reasons = []
+    for name in sorted(unknown):
+        close = difflib.get_close_matches(name, names, n=1, cutoff=0.5)
+        hint = (f'did you mean {close[0]!r}?' if close else
+                f'{node.get_name()} --help lists the parameters')
+        reasons.append(f'unknown parameter {name[:100]!r} ({hint})')
+    if reasons:
+        raise ConfigurationError('; '.join(reasons))
+
+
 def declare_parameters(node, specs):
     """
     Declare every parameter of ``specs`` on ``node``; return their values.
@@ -105,8 +219,10 @@ def declare_parameters(node, specs):
     ``specs`` is a list of :class:`..parameters.ParameterSpec`.  Each gets
     its description and read-only flag; the values (defaults or
     overrides, arrays as lists) are validated against the schema's rules.
-    A wrong type or an invalid value raises ConfigurationError.
+    A wrong type, an invalid value or an override that matches no
+    parameter (:func:`check_overrides`) raises ConfigurationError.
     """
+    check_overrides(node, specs)
     values = {}
     for spec in specs:
         desc = ParameterDescriptor(description=spec.description,
@@ -197,6 +313,12 @@ def run_node(make_node, name, args=None):
     # node loads its model and warms its kernels) waits for the
     # constructor.  rclpy's own handlers would shut the context down under
     # the constructor or a publishing callback (RCLError tracebacks).
+    global _PROCESS_ARGS
+    argv = sys.argv if args is None else args
+    if help_requested(argv):
+        print_help(name)
+        return 0
+    _PROCESS_ARGS = list(argv)
     stop = []
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda signum, frame: stop.append(signum))

@@ -18,7 +18,9 @@ Console-script entry points of the nodes.
 Importing a node pulls in rclpy, numpy and numba, which takes a second or
 two; a SIGINT or SIGTERM in that time would end in a KeyboardInterrupt
 traceback or a silent kill.  These entry points catch either signal from
-the very start and stop with one line and exit status 0; from
+the very start and stop with one line and exit status 0 (``--help``
+prints the node's description, topics and parameters and exits 0
+without starting ROS); from
 ``rclpy.init`` on, :func:`~newton_euler_ros.nodes.common.run_node` takes
 over.
 """
@@ -39,6 +41,11 @@ def _run(name, module):
         os._exit(0)
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, stop)
+    # --help: what the node does, its topics and parameters; no ROS
+    from ..parameters import help_requested, print_help
+    if help_requested(sys.argv[1:]):
+        print_help(name)
+        return 0
     return importlib.import_module(module).main()
 
 

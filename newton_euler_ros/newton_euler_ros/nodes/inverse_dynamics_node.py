@@ -53,6 +53,7 @@ from .common import (check_parameters, ConfigurationError,
                      declare_parameters, plain, qos_profile, release_memory,
                      run_node)
 from ..core import inspect_robot, NewtonEulerError
+from ..core.robot_file import Note
 from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
 from ..feedforward import (check_payload, clip, FeedforwardComputer,
@@ -120,7 +121,10 @@ class InverseDynamicsNode(Node):
             raise ConfigurationError(f'{key}: {exc}') from None
         if model is not None:
             for message in found:
-                self.get_logger().warning(f'robot file: {message}')
+                # notes on published data: `newton-euler check` shows them
+                log = (self.get_logger().debug if isinstance(message, Note)
+                       else self.get_logger().warning)
+                log(f'robot file: {message}')
             try:
                 self.ff = self._make_computer(model, scene)
             except ValueError as exc:
@@ -263,7 +267,9 @@ class InverseDynamicsNode(Node):
             if seq != self._description_seq:
                 return          # a newer description is on its way
             for message in found:
-                self.get_logger().warning(_clip(message))
+                log = (self.get_logger().debug if isinstance(message, Note)
+                       else self.get_logger().warning)
+                log(_clip(message))
             self.ff = ff        # one reference swap: callbacks see either
             self.counts['descriptions_loaded'] += 1
             self.model_source = (f'robot_description, {report["base"]} -> '

@@ -45,7 +45,9 @@ changed at run time: picking up an object.
 
 Subscribes
     ~/commands (std_msgs/Float64MultiArray: n torques, the model's order),
-    ~/joint_trajectory (trajectory_msgs/JointTrajectory)
+    ~/joint_trajectory (trajectory_msgs/JointTrajectory), wrench
+    (geometry_msgs/WrenchStamped, when the scene's wrench comes from the
+    topic)
 Publishes
     joint_states (sensor_msgs/JointState, effort = applied torque),
     wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),

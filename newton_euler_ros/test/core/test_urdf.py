@@ -450,9 +450,46 @@ def test_base_and_tip_apply_to_urdf_only():
 
 def test_warnings_name_massless_links_and_lumped_subtrees():
     _, found, _ = inspect_urdf(ARM, base='world', tip='tool0')
-    assert any('massless: tool0' in w for w in found)
+    # tool0 is a massless frame on a fixed joint: nothing to say about it
+    assert not any('massless' in w for w in found), found
     assert any('lumped rigidly' in w and 'grip (prismatic)' in w
                for w in found)
+    # a link a joint moves, without <inertial>, is worth a warning
+    l3 = inertial(0.5, '0 0.02 0.03', '0.4 -0.2 0.1')
+    bare = ARM.replace(f'<link name="l3">{l3}</link>', '<link name="l3"/>')
+    assert bare != ARM
+    _, found, _ = inspect_urdf(bare, base='world', tip='tool0')
+    assert any('massless: l3' in w for w in found), found
+
+
+def test_massless_frames_lumped_or_written_back_do_not_warn():
+    # an ee_link frame (zero-mass <inertial>) off the chain is lumped
+    # without a warning; a moving off-chain joint still gets one
+    frame = ('  <link name="ee_link"><inertial><mass value="0"/>'
+             '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+             '</inertial></link>\n  <joint name="ee_fixed" type="fixed">'
+             '<parent link="l3"/><child link="ee_link"/>'
+             '<origin xyz="0 0 0.05"/></joint>\n</robot>')
+    text = ARM.replace('</robot>', frame)
+    _, found, report = inspect_urdf(text, base='world', tip='tool0')
+    assert 'ee_fixed' in report['lumped']
+    assert not any('ee_fixed' in w or 'ee_link' in w for w in found), found
+    # what `newton-euler urdf` writes reads back without a word
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        load_urdf(model_to_urdf(quiet_load('panda')))
+        load_urdf(model_to_urdf(quiet_load('puma560')), tip='tool0')
+
+
+def test_mistyped_links_name_the_closest():
+    with pytest.raises(RobotFileError, match=r"tip link 'tol0' is not in "
+                       r"the URDF \(closest: 'tool0'"):
+        inspect_urdf(ARM, tip='tol0')
+    with pytest.raises(RobotFileError, match=r"base link 'wrld'.*closest: "
+                       r"'world'"):
+        inspect_urdf(ARM, base='wrld', tip='tool0')
+    with pytest.raises(RobotFileError, match=r'\(links: world, base_link, '):
+        inspect_urdf(ARM, tip='xyzzy')
 
 
 # ---------------------------------------------------------------------------
@@ -495,7 +532,7 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
             '-[j3]-> l3 -[flange]-> tool0') in out
     assert 'merged fixed joints: mount, flange' in out
     assert 'lumped off-chain subtrees (at zero position): grip' in out
-    assert 'massless: tool0' in out
+    assert 'massless' not in out          # tool0 is a frame
     code, out, err = run_cli('check', str(path))
     assert code != 0 and err.count('\n') == 1 and '2 leaves' in err
 
