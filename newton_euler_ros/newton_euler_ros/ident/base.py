@@ -87,9 +87,12 @@ def random_states(model, count, seed=0):
     return Q, rng.normal(size=(count, n)), rng.normal(size=(count, n))
 
 
-def structural_base(model, drives=True, count=300, seed=0):
-    """:class:`BaseInfo` of the model's regressor at random states."""
+def structural_base(model, drives=True, count=200, seed=0):
+    """Return the :class:`BaseInfo` of the regressor at random states."""
     from ..core.regressor import regressor_batch
     Q, QD, QDD = random_states(model, count, seed)
     Y = regressor_batch(model, Q, QD, QDD, drives=drives)
-    return base_parameters(Y.reshape(-1, Y.shape[2]))
+    # the R factor has the stacked regressor's column norms and singular
+    # values: the pivoted QR runs on a p x p matrix
+    return base_parameters(np.linalg.qr(Y.reshape(-1, Y.shape[2]),
+                                        mode='r'))

@@ -352,6 +352,7 @@ class Result:
     validate_stats: dict = field(default_factory=dict)
     info: dict = field(default_factory=dict)
     seconds: float = 0.0
+    validate_seconds: float = 0.0
     lambda_errors: list = field(default_factory=list)
 
 
@@ -438,12 +439,14 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
     if held is not train:
         result.fit_stats['held_out_nominal'] = held.stats(theta0)
         result.fit_stats['held_out_identified'] = held.stats(theta)
+    result.seconds = time.perf_counter() - start
     if validate is not None:
         val, _, vinfo = accumulate(model, validate, topic, eps, cutoff,
                                    split=False)
         result.validate_stats = {'nominal': val.stats(theta0),
                                  'identified': val.stats(theta)}
-    result.seconds = time.perf_counter() - start
+        result.validate_seconds = (time.perf_counter() - start
+                                   - result.seconds)
     return result
 
 
