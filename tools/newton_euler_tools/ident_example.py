@@ -204,7 +204,8 @@ def simulate(truth_urdf_path, model, drives, trajectory, seconds, rate,
 
 
 def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
-                 storage='mcap', validation=True, validation_seconds=20.0):
+                 storage='mcap', validation=True, validation_seconds=20.0,
+                 validation_storage=None):
     """Write the files the module docstring lists; return their paths."""
     import warnings
     from newton_euler_ros.core import load_robot
@@ -225,10 +226,11 @@ def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
         truth_path = os.path.join(tmp, 'truth.urdf')
         with open(truth_path, 'w', encoding='utf-8') as f:
             f.write(truth_text)
-        runs = [('recording', seconds, 1)]
+        runs = [('recording', seconds, 1, storage)]
         if validation:
-            runs.append(('validation', validation_seconds, 2))
-        for label, secs, k in runs:
+            runs.append(('validation', validation_seconds, 2,
+                         validation_storage or storage))
+        for label, secs, k, fmt in runs:
             traj = fourier_trajectory(model, np.random.default_rng(
                 [seed, k]), period=10.0 if k == 1 else 8.0)
             stamps, names, q, qd, e = simulate(
@@ -238,9 +240,9 @@ def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
             if os.path.exists(path):
                 shutil.rmtree(path)
             write_joint_states(path, stamps, names, q, qd, e,
-                               storage=storage)
+                               storage=fmt)
             paths[label] = path
-    truth = {'urdf': truth_text,
+    truth = {'urdf': truth_text, 'base': BASE, 'tip': TIP,
              'drives': {k: (v.tolist() if isinstance(v, np.ndarray) else v)
                         for k, v in drives.items()}}
     paths['truth'] = os.path.join(out_dir, 'truth.json')
