@@ -57,7 +57,7 @@ def register(subparsers):
                           "(default 0.02, or the nominal URDF's)")
     ide.add_argument('--overwrite', action='store_true',
                      help='allow -o to be the input URDF')
-    ide.set_defaults(func=cmd_identify)
+    ide.set_defaults(func=_one_line_exit_2(cmd_identify))
     rep = subparsers.add_parser(
         'replay', help="the model's torques along a recording, against the "
                        'measured efforts (CSV, plot)')
@@ -69,7 +69,7 @@ def register(subparsers):
                           'NAME.measured and NAME.model per joint')
     rep.add_argument('--plot', metavar='OUT.png',
                      help='draw measured against model per joint')
-    rep.set_defaults(func=cmd_replay)
+    rep.set_defaults(func=_one_line_exit_2(cmd_replay))
 
 
 def _common(parser):
@@ -84,9 +84,24 @@ def _common(parser):
                              'of the sample rate))')
 
 
+class _BadInput(Exception):
+    """One line for stderr; the command exits with status 2."""
+
+
 def _fail(message):
-    from .cli import CliError
-    raise CliError(message)
+    raise _BadInput(message)
+
+
+def _one_line_exit_2(command):
+    """Run ``command(args)``; a _BadInput becomes one line and status 2."""
+    def run(args):
+        try:
+            return command(args)
+        except _BadInput as exc:
+            print(f'newton-euler: error: {exc}', file=sys.stderr)
+            return EXIT_BAD_INPUT
+    run.__doc__ = command.__doc__
+    return run
 
 
 def _load_urdf(path, base, tip):
