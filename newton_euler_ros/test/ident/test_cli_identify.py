@@ -14,7 +14,6 @@
 
 """``newton-euler identify`` and ``replay`` as real processes."""
 import csv
-import os
 import shutil
 import subprocess
 import sys
@@ -64,7 +63,7 @@ def panda():
 
 def small_bag(path, model, m=600, rate=250.0, names=None, effort=True,
               still=False, storage='mcap'):
-    """A quick recording whose efforts come from the nominal model."""
+    """Write a quick recording whose efforts come from the nominal model."""
     rng = np.random.default_rng(1)
     t = np.arange(m) / rate
     n = model.n
