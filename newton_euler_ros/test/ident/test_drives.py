@@ -71,7 +71,7 @@ def test_read_back_from_urdf():
 @pytest.mark.parametrize('bad, text', [
     ('<dynamics damping="-1"/>',
      r"joint 'joint3' <dynamics> damping: must be >= 0"),
-    ('<dynamics friction="nan"/>', "<dynamics> friction: must be a finite"),
+    ('<dynamics friction="nan"/>', '<dynamics> friction: must be a finite'),
     ('<ne:drive armature="-0.1"/>', '<ne:drive> armature: must be >= 0'),
     ('<ne:drive coulomb_width="0"/>', 'coulomb_width: must be > 0'),
 ])
