@@ -37,6 +37,7 @@ import sys
 
 import numpy as np
 
+from .cli_identify import register as register_identify
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
                    RobotFileError)
@@ -413,6 +414,7 @@ def build_parser():
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
+    register_identify(sub)
     return parser
 
 

@@ -419,12 +419,20 @@ class FeedforwardComputer:
         self.last_q = None
         self.last_qd = None
 
+    #: ``core.drives.Drives`` to add (friction, offset, rotor inertia),
+    #: or None; set by the node when ``drives.compensate`` is on
+    drives = None
+
     def _torques(self, q, qd, qdd, w, frame, out=None):
         """Inverse dynamics with the scene's effects, or all of them."""
         try:
-            return self.dyn.torques(q, qd, qdd, w, frame, out=out)
+            tau = self.dyn.torques(q, qd, qdd, w, frame, out=out)
         except DynamicsInputError as exc:   # finite input that overflows
             raise InputRejected('non_finite', str(exc)) from None
+        if self.drives is not None:
+            tau += self.drives.torques(qd, self.zeros if qdd is None
+                                       else qdd)
+        return tau
 
     def warm_up(self):
         """

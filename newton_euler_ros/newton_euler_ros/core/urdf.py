@@ -467,6 +467,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     """
+    from .drives import read_drives
     from .robot_file import triangle_note
     name, root, links, joints = parse_urdf(text, label)
     found = []
@@ -606,7 +607,10 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         joint_types=[MOVING[joints[j].kind] for j in moving],
         joint_pre=pre, joint_axis=[joints[j].axis for j in moving],
         mass=mass, com=com, inertia=inertia, gravity=gravity, tool=tool,
-        limits=limits, info={'source': label, 'urdf': report})
+        limits=limits, info={'source': label, 'urdf': report,
+                             # friction, offset, rotor inertia (or None)
+                             'drives': read_drives(_parse(text, _Source(
+                                 label)), moving, label)})
     return model, found, report
 
 

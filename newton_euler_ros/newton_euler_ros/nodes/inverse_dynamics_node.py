@@ -219,6 +219,9 @@ class InverseDynamicsNode(Node):
                                              p['limits.max_velocity'])
         ff.max_future = p['joint_states.max_future']
         ff.max_age = p['joint_states.max_age']
+        if p['drives.compensate']:
+            from ..core.drives import model_drives
+            ff.drives = model_drives(bare)
         ff.warm_up()   # compile or load the kernels before any message
         ff.output_names = list(order.output_joints)
         ff.bare_model = bare
@@ -233,7 +236,11 @@ class InverseDynamicsNode(Node):
             f'{model.name} ({source}): {model.n} joints '
             f'[{", ".join(ff.output_names)}], mode {self.mode}, effects '
             f'{effects}, payload {self.payload[0]} kg, wrench frames '
-            f'{_clip(str(sorted(ff.wrench.frames)))}')
+            f'{_clip(str(sorted(ff.wrench.frames)))}'
+            + ('' if not self.params['drives.compensate'] else
+               ', drive terms compensated' if ff.drives is not None else
+               ', drives.compensate is on but the robot has no drive '
+               'terms'))
 
     # ---- robot_description ----
     def _on_description(self, msg):

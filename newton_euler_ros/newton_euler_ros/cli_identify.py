@@ -1,0 +1,324 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+``newton-euler identify`` and ``newton-euler replay``.
+
+    newton-euler identify NOMINAL.urdf BAG --base LINK --tip LINK
+                          -o IDENTIFIED.urdf [--topic T] [--validate BAG2]
+                          [--coulomb-width EPS] [--cutoff HZ] [--overwrite]
+    newton-euler replay MODEL.urdf BAG --base LINK --tip LINK --csv OUT.csv
+                        [--plot OUT.png] [--topic T] [--cutoff HZ]
+
+Every problem with an input (a bag that is missing, corrupt or truncated,
+lacks the topic, the effort or a chain joint, is too short or does not
+excite the arm; an unusable URDF; an output that would overwrite the
+input) is one line on stderr naming the file, exit status 2.  Every file
+written (URDF, CSV, plot) is written atomically.  The identification
+pipeline (``newton_euler_ros.ident``) is imported only by these
+commands, never by the nodes.
+"""
+import os
+import sys
+import time
+
+import numpy as np
+
+EXIT_BAD_INPUT = 2
+
+
+def register(subparsers):
+    """Add the ``identify`` and ``replay`` commands to ``subparsers``."""
+    ide = subparsers.add_parser(
+        'identify', help='identify inertials and drive terms from a rosbag2 '
+                         'recording of /joint_states; write a URDF')
+    ide.add_argument('nominal', metavar='NOMINAL.urdf',
+                     help='the URDF to start from (the prior)')
+    ide.add_argument('bag', metavar='BAG', help='rosbag2 directory (MCAP or '
+                                                'sqlite3)')
+    _common(ide)
+    ide.add_argument('-o', '--output', metavar='IDENTIFIED.urdf',
+                     required=True, help='URDF to write')
+    ide.add_argument('--validate', metavar='BAG2',
+                     help='a second recording to report the models on')
+    ide.add_argument('--coulomb-width', type=float, metavar='EPS',
+                     help='Coulomb smoothing width of tanh(qd / EPS), rad/s '
+                          "(default 0.02, or the nominal URDF's)")
+    ide.add_argument('--overwrite', action='store_true',
+                     help='allow -o to be the input URDF')
+    ide.set_defaults(func=_one_line_exit_2(cmd_identify))
+    rep = subparsers.add_parser(
+        'replay', help="the model's torques along a recording, against the "
+                       'measured efforts (CSV, plot)')
+    rep.add_argument('model', metavar='MODEL.urdf')
+    rep.add_argument('bag', metavar='BAG')
+    _common(rep)
+    rep.add_argument('--csv', metavar='OUT.csv', required=True,
+                     help='one row per JointState message: time, then '
+                          'NAME.measured and NAME.model per joint')
+    rep.add_argument('--plot', metavar='OUT.png',
+                     help='draw measured against model per joint')
+    rep.set_defaults(func=_one_line_exit_2(cmd_replay))
+
+
+def _common(parser):
+    parser.add_argument('--base', metavar='LINK', required=True,
+                        help='first link of the chain')
+    parser.add_argument('--tip', metavar='LINK', required=True,
+                        help='last link of the chain')
+    parser.add_argument('--topic', default='/joint_states',
+                        help='JointState topic (default /joint_states)')
+    parser.add_argument('--cutoff', type=float, metavar='HZ',
+                        help='low-pass cutoff (default min(10 Hz, a fifth '
+                             'of the sample rate))')
+
+
+class _BadInput(Exception):
+    """One line for stderr; the command exits with status 2."""
+
+
+def _fail(message):
+    raise _BadInput(message)
+
+
+def _one_line_exit_2(command):
+    """Run ``command(args)``; a _BadInput becomes one line and status 2."""
+    def run(args):
+        try:
+            return command(args)
+        except _BadInput as exc:
+            print(f'newton-euler: error: {exc}', file=sys.stderr)
+            return EXIT_BAD_INPUT
+    run.__doc__ = command.__doc__
+    return run
+
+
+def _load_urdf(path, base, tip):
+    """Return (model, text, notes) or fail with one line."""
+    from .core import NewtonEulerError
+    from .core.robot_file import Note
+    from .core.urdf import inspect_urdf, read_urdf_text
+    if not os.path.isfile(path):
+        _fail(f'{path}: no such URDF file')
+    try:
+        text, label = read_urdf_text(path)
+        model, found, _ = inspect_urdf(text, base=base, tip=tip,
+                                       label=path)
+    except NewtonEulerError as exc:
+        _fail(str(exc))
+    notes = []
+    for message in found:
+        kind = 'note' if isinstance(message, Note) or 'triangle' in str(
+            message) else 'warning'
+        notes.append(f'{kind}: {message}')
+    return model, text, notes
+
+
+def _table(title, names, columns):
+    """Print a per-joint table; columns: [(header, values, fmt)]."""
+    print(title)
+    width = max(len(n) for n in names) + 2
+    heads = ''.join(f'{h:>18}' for h, _, _ in columns)
+    print(f'  {"joint":<{width}}' + heads)
+    for j, name in enumerate(names):
+        print(f'  {name:<{width}}' + ''.join(
+            f'{fmt.format(v[j]):>18}' for _, v, fmt in columns))
+    print(f'  {"mean":<{width}}' + ''.join(
+        f'{fmt.format(float(np.mean(v))):>18}' for _, v, fmt in columns))
+
+
+def _stats_table(title, names, stats):
+    rms0, rel0 = stats['nominal']
+    rms1, rel1 = stats['identified']
+    _table(title, names, [('nominal RMS', rms0, '{:.4g}'),
+                          ('nominal rel %', rel0 * 100, '{:.2f}'),
+                          ('identified RMS', rms1, '{:.4g}'),
+                          ('identified rel %', rel1 * 100, '{:.2f}')])
+    return float(np.mean(rel0)), float(np.mean(rel1))
+
+
+def cmd_identify(args):
+    """Run ``newton-euler identify``."""
+    from .core import NewtonEulerError
+    start = time.perf_counter()
+    src = os.path.abspath(args.nominal)
+    out = os.path.abspath(args.output)
+    if os.path.exists(out) and os.path.exists(src) and (
+            os.path.samefile(src, out)) and not args.overwrite:
+        _fail(f'{args.output}: is the input URDF; refusing to overwrite it '
+              f'(choose another -o, or add --overwrite)')
+    if not os.path.isdir(os.path.dirname(out)):
+        _fail(f'{args.output}: the directory does not exist')
+    if args.coulomb_width is not None and not args.coulomb_width > 0:
+        _fail(f'--coulomb-width must be > 0, got {args.coulomb_width:g}')
+    model, text, notes = _load_urdf(args.nominal, args.base, args.tip)
+    for line in notes:
+        print(line, file=sys.stderr)
+    from .ident.fit import fixed_parts, identify
+    from .ident.urdf_out import atomic_write, identified_urdf
+    try:
+        result = identify(model, args.bag, topic=args.topic,
+                          validate=args.validate,
+                          coulomb_width=args.coulomb_width,
+                          cutoff=args.cutoff, urdf_text=text)
+    except (NewtonEulerError, ValueError) as exc:
+        _fail(str(exc))
+    info = result.info
+    names = model.joint_names
+    print(f'recording {args.bag}: {info["samples"]} samples over '
+          f'{info["duration"]:.1f} s at {info["rate"]:.0f} Hz, low-pass '
+          f'{info["cutoff"]:g} Hz, fit on every {info["step"]} sample(s)')
+    print(f'rank {result.rank} of {result.structural_rank} base parameters '
+          f'(of {14 * model.n}: 10 inertial + 4 drive per joint); '
+          f'condition number {result.condition:.3g}')
+    print(f'prior weight {result.lam:g} (chosen on held-out blocks); '
+          f'Coulomb width {result.coulomb_width:g} rad/s')
+    _stats_table('torque residual on the recording (N m; relative to the '
+                 'RMS effort):', names, {
+                     'nominal': result.fit_stats['nominal'],
+                     'identified': result.fit_stats['identified']})
+    worse = []
+    if 'held_out_nominal' in result.fit_stats:
+        n0, n1 = _stats_table('on the held-out blocks (not fitted):', names, {
+            'nominal': result.fit_stats['held_out_nominal'],
+            'identified': result.fit_stats['held_out_identified']})
+        if n1 >= n0:
+            worse.append('the held-out blocks')
+    if result.validate_stats:
+        n0, n1 = _stats_table(f'on {args.validate} (validation):', names,
+                              result.validate_stats)
+        if n1 >= n0:
+            worse.append(args.validate)
+    f0 = float(np.mean(result.fit_stats['nominal'][1]))
+    f1 = float(np.mean(result.fit_stats['identified'][1]))
+    if f1 >= f0:
+        worse.append('the recording')
+    fixed = fixed_parts(model, text)
+    body = identified_urdf(text, model, result.theta, fixed, result.drives)
+    try:
+        atomic_write(out, body)
+    except OSError as exc:
+        _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
+    for where in worse:
+        print(f'warning: the identified model does WORSE than the nominal on '
+              f'{where}: check the recording (excitation, effort units, '
+              f'joint names)', file=sys.stderr)
+    print(f'wrote {args.output}')
+    print(f'identified in {result.seconds:.2f} s'
+          + (f', validated in {result.validate_seconds:.2f} s'
+             if result.validate_stats else '')
+          + f' (whole command {time.perf_counter() - start:.2f} s)')
+    return 0
+
+
+def cmd_replay(args):
+    """Run ``newton-euler replay``."""
+    from .core import NewtonEulerError
+    from .core.drives import model_drives
+    from .ident.bag import read_joint_states
+    from .ident.fit import predict
+    from .ident.signals import prepare
+    from .ident.urdf_out import atomic_open
+    for opt, path in (('--csv', args.csv), ('--plot', args.plot)):
+        if path is not None and not os.path.isdir(
+                os.path.dirname(os.path.abspath(path))):
+            _fail(f'{path}: the directory does not exist ({opt})')
+    model, _, notes = _load_urdf(args.model, args.base, args.tip)
+    for line in notes:
+        print(line, file=sys.stderr)
+    drives = model_drives(model)
+    try:
+        js = read_joint_states(args.bag, model.joint_names, args.topic)
+        prep = prepare(js.stamps, js.q, js.qd, js.effort, cutoff=args.cutoff)
+    except (NewtonEulerError, ValueError) as exc:
+        _fail(str(exc) if str(exc).startswith(str(args.bag))
+              else f'{args.bag}: {exc}')
+    if prep is None:
+        _fail(f'{args.bag}: too short: nothing is left after filtering')
+    model_tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
+    # the messages inside the filtered stretches (edges left out)
+    i = np.clip(np.searchsorted(prep.t, js.stamps), 1, len(prep.t) - 1)
+    near = np.minimum(np.abs(prep.t[i] - js.stamps),
+                      np.abs(prep.t[i - 1] - js.stamps))
+    keep = near <= 1.0 / prep.rate
+    n = model.n
+    at = js.stamps[keep]
+    mod = np.column_stack([np.interp(at, prep.t, model_tau[:, j])
+                           for j in range(n)])
+    low = np.column_stack([np.interp(at, prep.t, prep.effort[:, j])
+                           for j in range(n)])
+    meas = js.effort[keep]
+    ns = js.stamps_ns[keep]
+    names = model.joint_names
+    try:
+        with atomic_open(args.csv) as f:
+            f.write('time,' + ','.join(f'{x}.measured,{x}.model'
+                                       for x in names) + '\n')
+            for a in range(0, len(ns), 10000):
+                rows = []
+                meas_l = meas[a:a + 10000].tolist()
+                mod_l = mod[a:a + 10000].tolist()
+                for r in range(a, min(a + 10000, len(ns))):
+                    cells = ','.join(f'{mr!r},{mo!r}' for mr, mo in zip(
+                        meas_l[r - a], mod_l[r - a]))
+                    t = int(ns[r])
+                    rows.append(f'{t // 1_000_000_000}.'
+                                f'{t % 1_000_000_000:09d},{cells}\n')
+                f.write(''.join(rows))
+    except OSError as exc:
+        _fail(f'{args.csv}: cannot write: {exc.strerror or exc}')
+    err = mod - meas
+    rms = np.sqrt(np.mean(err ** 2, axis=0))
+    rel = rms / np.maximum(np.sqrt(np.mean(meas ** 2, axis=0)), 1e-300)
+    rms_l = np.sqrt(np.mean((mod - low) ** 2, axis=0))
+    rel_l = rms_l / np.maximum(np.sqrt(np.mean(low ** 2, axis=0)), 1e-300)
+    print(f'{args.bag}: {len(ns)} of {len(js)} messages (filter edges and '
+          f'gaps left out); model {args.model}'
+          + ('' if drives is not None else ' (no drive terms)'))
+    _table('model torque against the measured effort (N m; relative to the '
+           'RMS effort):', names,
+           [('RMS raw', rms, '{:.4g}'), ('rel % raw', rel * 100, '{:.2f}'),
+            (f'RMS {prep.cutoff:g} Hz', rms_l, '{:.4g}'),
+            (f'rel % {prep.cutoff:g} Hz', rel_l * 100, '{:.2f}')])
+    print(f'wrote {args.csv}')
+    if args.plot:
+        _plot(args.plot, (ns - ns[0]) * 1e-9, names, meas, mod, low)
+        print(f'wrote {args.plot}')
+    return 0
+
+
+def _plot(path, t, names, meas, mod, low):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    from .ident.urdf_out import atomic_open
+    n = len(names)
+    fig, axes = plt.subplots(n, 1, sharex=True, figsize=(10, 1.8 * n + 1),
+                             squeeze=False)
+    for j, ax in enumerate(axes[:, 0]):
+        ax.plot(t, meas[:, j], color='0.7', lw=0.6, label='measured')
+        ax.plot(t, low[:, j], color='k', lw=0.9, label='measured, low-pass')
+        ax.plot(t, mod[:, j], color='tab:red', lw=0.9, label='model')
+        ax.set_ylabel(f'{names[j]}\nN m', fontsize=8)
+        ax.tick_params(labelsize=7)
+    axes[0, 0].legend(loc='upper right', fontsize=7, ncol=3)
+    axes[-1, 0].set_xlabel('time (s)')
+    fig.tight_layout()
+    try:
+        with atomic_open(path, 'wb') as f:
+            fig.savefig(f, format='png', dpi=90)
+    except OSError as exc:
+        _fail(f'{path}: cannot write: {exc.strerror or exc}')
+    finally:
+        plt.close(fig)

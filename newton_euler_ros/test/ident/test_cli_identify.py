@@ -1,0 +1,223 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""``newton-euler identify`` and ``replay`` as real processes."""
+import csv
+import shutil
+import subprocess
+import sys
+import warnings
+
+from newton_euler_ros.core import inverse_dynamics_batch, load_robot
+from newton_euler_ros.ident.bag import read_joint_states, write_joint_states
+from newton_euler_tools.ident_example import (BASE, make_example,
+                                              panda_path, TIP)
+import numpy as np
+import pytest
+
+CHAIN = ['--base', BASE, '--tip', TIP]
+
+
+def run(*args, cwd=None):
+    proc = subprocess.run(
+        [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)],
+        capture_output=True, text=True, cwd=cwd, timeout=300)
+    return proc.returncode, proc.stdout, proc.stderr
+
+
+def one_line_error(err, *names):
+    lines = [x for x in err.splitlines()
+             if not x.startswith(('warning:', 'note:'))]
+    assert len(lines) == 1, err
+    assert lines[0].startswith('newton-euler: error: '), err
+    assert 'Traceback' not in err
+    for name in names:
+        assert str(name) in lines[0], (name, lines[0])
+    return lines[0]
+
+
+@pytest.fixture(scope='module')
+def example(tmp_path_factory):
+    out = tmp_path_factory.mktemp('cli')
+    return make_example(str(out), seconds=16.0, rate=250.0, seed=5,
+                        validation_seconds=8.0, validation_storage='sqlite3')
+
+
+@pytest.fixture(scope='module')
+def panda():
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return load_robot(panda_path(), base=BASE, tip=TIP)
+
+
+def small_bag(path, model, m=600, rate=250.0, names=None, effort=True,
+              still=False, storage='mcap'):
+    """Write a quick recording whose efforts come from the nominal model."""
+    rng = np.random.default_rng(1)
+    t = np.arange(m) / rate
+    n = model.n
+    phase = rng.uniform(0, 6, n)
+    amp = 0.0 if still else 0.4
+    q = -0.5 + amp * np.sin(1.3 * t[:, None] + phase)
+    q[:, 3] -= 1.5
+    qd = amp * 1.3 * np.cos(1.3 * t[:, None] + phase)
+    qdd = -amp * 1.69 * np.sin(1.3 * t[:, None] + phase)
+    tau = inverse_dynamics_batch(model, q, qd, qdd)
+    tau += rng.normal(0, 0.02, tau.shape)
+    names = list(model.joint_names) if names is None else names
+    k = len(names)
+    stamps = 10**9 + np.round(t * 1e9).astype(np.int64)
+    write_joint_states(path, stamps, names, q[:, :k], qd[:, :k],
+                       tau[:, :k] if effort else None, storage=storage)
+    return path
+
+
+def test_identify_and_replay(example, tmp_path):
+    out = tmp_path / 'identified.urdf'
+    code, stdout, err = run('identify', example['urdf'],
+                            example['recording'], *CHAIN, '-o', out,
+                            '--validate', example['validation'])
+    assert code == 0, err
+    assert 'Traceback' not in err
+    for word in ('rank ', 'condition number', 'nominal rel %',
+                 'identified rel %', 'validation', 'identified in '):
+        assert word in stdout, word
+    assert out.exists()
+    csv_path = tmp_path / 'replay.csv'
+    png = tmp_path / 'replay.png'
+    code, stdout, err = run('replay', out, example['validation'], *CHAIN,
+                            '--csv', csv_path, '--plot', png)
+    assert code == 0, err
+    assert png.stat().st_size > 1000
+    with open(csv_path, newline='') as f:
+        rows = list(csv.reader(f))
+    names = [f'panda_joint{k}' for k in range(1, 8)]
+    assert rows[0] == ['time'] + [f'{x}.{s}' for x in names
+                                  for s in ('measured', 'model')]
+    js = read_joint_states(example['validation'], names)
+    # one row per message (filter edges left out), its stamp to the ns
+    stamps = {f'{t // 10**9}.{t % 10**9:09d}' for t in js.stamps_ns}
+    assert all(r[0] in stamps for r in rows[1:])
+    assert 0.8 * len(js) < len(rows) - 1 <= len(js)
+    data = np.array(rows[1:], dtype=float)[:, 1:]
+    meas, model = data[:, 0::2], data[:, 1::2]
+    rel = np.sqrt(np.mean((meas - model) ** 2, axis=0) / np.mean(
+        meas ** 2, axis=0))
+    assert rel.mean() < 0.1
+    assert 'rel % raw' in stdout
+
+
+def test_refuses_to_overwrite_the_input(example, tmp_path):
+    urdf = tmp_path / 'panda.urdf'
+    shutil.copyfile(example['urdf'], urdf)
+    before = urdf.read_bytes()
+    code, _, err = run('identify', urdf, example['recording'], *CHAIN,
+                       '-o', urdf)
+    assert code == 2
+    one_line_error(err, urdf, 'overwrite')
+    assert urdf.read_bytes() == before
+
+
+def test_impossible_nominal_inertials_are_a_prior_with_a_note(example,
+                                                              tmp_path):
+    text = open(example['urdf'], encoding='utf-8').read()
+    # link 5's principal moments break the triangle inequality
+    start = text.index('<link name="panda_link5">')
+    i = text.index('<inertia ', start)
+    j = text.index('/>', i)
+    text = text[:i] + ('<inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" '
+                       'iyz="0" izz="0.05"') + text[j:]
+    urdf = tmp_path / 'odd.urdf'
+    urdf.write_text(text)
+    out = tmp_path / 'out.urdf'
+    code, stdout, err = run('identify', urdf, example['recording'], *CHAIN,
+                            '-o', out)
+    assert code == 0, err
+    assert 'note:' in err and 'triangle' in err
+    assert out.exists()
+
+
+def bad_case(case, tmp_path, example, panda):
+    """Return (args, names the error must contain)."""
+    urdf = example['urdf']
+    bag = tmp_path / 'bag'
+    topic = []
+    if case == 'missing':
+        pass
+    elif case == 'corrupt':
+        bag.mkdir()
+        (bag / 'metadata.yaml').write_text('rosbag2_bagfile_information: [')
+    elif case == 'truncated':
+        shutil.copytree(example['validation'], bag)
+        db = next(p for p in bag.iterdir() if p.suffix == '.db3')
+        raw = db.read_bytes()
+        db.write_bytes(raw[:len(raw) // 3])
+    elif case == 'truncated_mcap':
+        shutil.copytree(example['recording'], bag)
+        data = next(p for p in bag.iterdir() if p.suffix == '.mcap')
+        raw = data.read_bytes()
+        data.write_bytes(raw[:len(raw) // 3])
+    elif case == 'topic':
+        small_bag(bag, panda)
+        topic = ['--topic', '/arm/joint_states']
+    elif case == 'effort':
+        small_bag(bag, panda, effort=False)
+    elif case == 'joint':
+        small_bag(bag, panda, names=list(panda.joint_names[:6]))
+    elif case == 'short':
+        small_bag(bag, panda, m=30)
+    elif case == 'still':
+        small_bag(bag, panda, m=2500, still=True)
+    elif case == 'urdf':
+        urdf = tmp_path / 'nope.urdf'
+        small_bag(bag, panda)
+        return [urdf, bag] + topic, [urdf]
+    return [urdf, bag] + topic, [bag]
+
+
+BAD = [('missing', 'no such bag'), ('corrupt', 'cannot open'),
+       ('truncated', ''), ('truncated_mcap', ''),
+       ('topic', "no topic '/arm/joint_states'"), ('effort', 'no effort'),
+       ('joint', 'panda_joint7'), ('short', 'too short'),
+       ('still', 'does not excite'), ('urdf', 'no such URDF')]
+
+
+@pytest.mark.parametrize('case, words', BAD)
+def test_bad_input_is_one_line_exit_2(case, words, tmp_path, example,
+                                      panda):
+    args, names = bad_case(case, tmp_path, example, panda)
+    out = tmp_path / 'out.urdf'
+    code, stdout, err = run('identify', *args[:2], *CHAIN, '-o', out,
+                            *args[2:])
+    assert code == 2, (stdout, err)
+    line = one_line_error(err, *names)
+    assert words in line
+    assert not out.exists()
+    if case in ('missing', 'effort'):
+        csv_path = tmp_path / 'r.csv'
+        code, _, err = run('replay', args[0], args[1], *CHAIN, '--csv',
+                           csv_path, *args[2:])
+        assert code == 2
+        assert words in one_line_error(err, *names)
+        assert not csv_path.exists()
+
+
+def test_validate_bag_errors_name_it(example, tmp_path):
+    out = tmp_path / 'out.urdf'
+    missing = tmp_path / 'nothing'
+    code, _, err = run('identify', example['urdf'], example['recording'],
+                       *CHAIN, '-o', out, '--validate', missing)
+    assert code == 2
+    one_line_error(err, missing)
+    assert not out.exists()
