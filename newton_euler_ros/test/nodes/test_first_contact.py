@@ -272,6 +272,15 @@ def test_mistyped_tip_link_names_the_closest_links(puma_urdf):
         "'base_link'" in proc.stderr
 
 
+def test_urdf_written_by_the_cli_reads_back_without_a_warning(puma_urdf):
+    proc = subprocess.run([script('newton-euler'), 'dynamics', puma_urdf,
+                           '--q', *['0.1'] * 6], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr == ''                    # tool0 is a frame
+    assert 'puma560: 6 joints' in proc.stdout
+
+
 def test_library_first_example_prints_no_warning():
     code = ('import numpy as np\n'
             'from newton_euler_ros.core import load_robot, Workspace, '
