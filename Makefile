@@ -48,6 +48,7 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_urdf
 	$(PY) -m newton_euler_tools.bench_trajectory
 	$(PY) -m newton_euler_tools.bench_scaling
+	$(PY) -m newton_euler_tools.bench_observer
 
 latency: setup
 	$(PY) -m newton_euler_tools.latency_bench
