@@ -1,0 +1,377 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Read ``sensor_msgs/JointState`` from a rosbag2 recording, without ROS.
+
+The reader is ``rosbags.highlevel.AnyReader`` (pure Python): it opens
+rosbag2 directories in either storage, MCAP (Jazzy's default) or sqlite3
+(Humble's default), and deserialises with the type definitions stored in
+the bag, or the Jazzy typestore when the bag has none.
+
+What real recordings need, and what this module does about it:
+
+- JointState lists every joint (fingers too) in any order, and the order
+  may change between publishers: the chain's joints are picked by name in
+  every message.
+- Time is the message's ``header.stamp`` (never the message index: stamps
+  jitter and messages get lost), kept as integer nanoseconds
+  (``stamps_ns``); ``stamps`` is the float time in seconds since the first
+  kept sample, which keeps nanosecond resolution for any realistic length.
+  A bag whose header stamps are all zero falls back to the recording
+  (log) time, with a note.
+- Repeated samples (the same values with a later stamp, or the same stamp
+  twice) and samples whose stamp goes backwards are dropped and counted.
+- Messages without an effort (or position) for the chain are dropped and
+  counted; velocity may be absent: ``qd`` is then None (differentiate).
+- The bag is read in chunks (:func:`iter_joint_states`), so a long
+  recording never has to be in memory at once.
+
+Every problem with the file raises :class:`BagError` with one line naming
+the bag and what is wrong (missing, corrupt or truncated, no such topic,
+no effort, a chain joint missing, too short).
+"""
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..core.errors import NewtonEulerError
+
+DEFAULT_TOPIC = '/joint_states'
+JOINT_STATE = 'sensor_msgs/msg/JointState'
+# Fewer kept samples than this is "too short" to filter and fit.
+MIN_SAMPLES = 50
+DEFAULT_CHUNK = 65536
+
+
+class BagError(NewtonEulerError, ValueError):
+    """A recording cannot be used; the message is one line naming the bag."""
+
+
+@dataclass
+class JointStates:
+    """
+    Samples of the chain's joints, in the order of ``names``.
+
+    Unpacks as ``stamps, q, qd, effort``.  ``stamps`` are seconds since
+    ``t0_ns`` (the first kept stamp of the recording); ``stamps_ns`` the
+    absolute header stamps in integer nanoseconds.
+    """
+
+    stamps: np.ndarray
+    q: np.ndarray
+    qd: object
+    effort: np.ndarray
+    stamps_ns: np.ndarray
+    names: tuple
+    t0_ns: int = 0
+    counts: dict = field(default_factory=dict)
+    notes: list = field(default_factory=list)
+
+    def __iter__(self):
+        """Unpack as (stamps, q, qd, effort)."""
+        return iter((self.stamps, self.q, self.qd, self.effort))
+
+    def __len__(self):
+        """Return the number of samples."""
+        return len(self.stamps_ns)
+
+
+def _label(path):
+    return str(path)
+
+
+def _open(path):
+    """Open the bag with AnyReader; BagError on any failure."""
+    from rosbags.highlevel import AnyReader
+    from rosbags.typesys import get_typestore, Stores
+
+    p = Path(path)
+    label = _label(path)
+    if not p.exists():
+        raise BagError(f'{label}: no such bag (file or directory)')
+    try:
+        reader = AnyReader(
+            [p], default_typestore=get_typestore(Stores.ROS2_JAZZY))
+        reader.open()
+    except Exception as err:  # noqa: BLE001 (rosbags raises many kinds)
+        raise BagError(f'{label}: cannot open the bag (corrupt, truncated '
+                       f'or not a rosbag2 recording): {_one_line(err)}'
+                       ) from None
+    return reader
+
+
+def _one_line(err):
+    text = ' '.join(str(err).split()) or type(err).__name__
+    return text if len(text) <= 200 else text[:197] + '...'
+
+
+def _connections(reader, label, topic):
+    conns = [c for c in reader.connections if c.topic == topic]
+    if not conns:
+        topics = sorted({c.topic for c in reader.connections})
+        shown = ', '.join(topics[:8]) + (' ...' if len(topics) > 8 else '')
+        raise BagError(f'{label}: no topic {topic!r} in the bag (topics: '
+                       f'{shown or "none"})')
+    bad = [c.msgtype for c in conns if c.msgtype != JOINT_STATE]
+    if bad:
+        raise BagError(f'{label}: topic {topic!r} carries {bad[0]}, not '
+                       f'{JOINT_STATE}')
+    return conns
+
+
+class _Selector:
+    """Index of each chain joint in a message's name list (cached)."""
+
+    def __init__(self, joint_names, label, topic):
+        self.joint_names = tuple(joint_names)
+        self.label = label
+        self.topic = topic
+        self.cache = {}
+
+    def __call__(self, names):
+        key = tuple(names)
+        idx = self.cache.get(key)
+        if idx is None:
+            where = {name: i for i, name in enumerate(key)}
+            missing = [j for j in self.joint_names if j not in where]
+            if missing:
+                idx = missing
+            else:
+                idx = np.array([where[j] for j in self.joint_names])
+            self.cache[key] = idx
+        return idx
+
+
+def _pick(values, idx):
+    if len(values) == 0:
+        return None
+    a = np.asarray(values, dtype=np.float64)
+    if a.shape[0] <= int(idx.max()):
+        return None
+    return a[idx]
+
+
+def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
+                      chunk=DEFAULT_CHUNK, min_samples=MIN_SAMPLES):
+    """
+    Yield :class:`JointStates` chunks of at most ``chunk`` kept samples.
+
+    Stamps are strictly increasing across chunks (duplicates and samples
+    going back in time are dropped).  The last chunk's ``counts`` hold the
+    totals for the whole bag: ``messages``, ``kept``, ``duplicates``,
+    ``backwards``, ``no_effort``, ``no_position``, ``missing_joint``.
+    Raises :class:`BagError` (before the first chunk when it can: missing
+    bag, topic or joints; else when found, e.g. a truncated file).
+    """
+    label = _label(path)
+    joint_names = tuple(joint_names)
+    n = len(joint_names)
+    select = _Selector(joint_names, label, topic)
+    reader = _open(path)
+    counts = {'messages': 0, 'kept': 0, 'duplicates': 0, 'backwards': 0,
+              'no_effort': 0, 'no_position': 0, 'missing_joint': 0}
+    notes = []
+    try:
+        conns = _connections(reader, label, topic)
+        if sum(c.msgcount for c in conns) == 0:
+            raise BagError(f'{label}: topic {topic!r} has no messages')
+        buf_t = np.empty(chunk, dtype=np.int64)
+        buf_q = np.empty((chunk, n))
+        buf_v = np.empty((chunk, n))
+        buf_e = np.empty((chunk, n))
+        k = 0
+        last_t = None
+        last_vals = None
+        have_qd = True
+        use_logtime = None
+        missing_seen = None
+        t0 = None
+        stream = reader.messages(connections=conns)
+        while True:
+            try:
+                item = next(stream)
+            except StopIteration:
+                break
+            except Exception as err:  # noqa: BLE001
+                raise BagError(f'{label}: the bag is corrupt or truncated '
+                               f'after {counts["messages"]} messages: '
+                               f'{_one_line(err)}') from None
+            conn, logtime, raw = item
+            try:
+                msg = reader.deserialize(raw, conn.msgtype)
+            except Exception as err:  # noqa: BLE001
+                raise BagError(f'{label}: message {counts["messages"]} on '
+                               f'{topic!r} cannot be decoded (corrupt '
+                               f'bag?): {_one_line(err)}') from None
+            counts['messages'] += 1
+            idx = select(msg.name)
+            if isinstance(idx, list):
+                counts['missing_joint'] += 1
+                missing_seen = idx
+                continue
+            q = _pick(msg.position, idx)
+            if q is None:
+                counts['no_position'] += 1
+                continue
+            e = _pick(msg.effort, idx)
+            if e is None:
+                counts['no_effort'] += 1
+                continue
+            v = _pick(msg.velocity, idx)
+            if v is None:
+                have_qd = False
+            stamp = msg.header.stamp.sec * 1_000_000_000 \
+                + msg.header.stamp.nanosec
+            if use_logtime is None:
+                use_logtime = stamp == 0
+                if use_logtime:
+                    notes.append('header stamps are zero: using the '
+                                 'recording time')
+            t = int(logtime) if use_logtime else int(stamp)
+            vals = (q, v, e)
+            if last_t is not None:
+                if t < last_t:
+                    counts['backwards'] += 1
+                    continue
+                if t == last_t or _same(vals, last_vals):
+                    counts['duplicates'] += 1
+                    continue
+            last_t, last_vals = t, vals
+            if t0 is None:
+                t0 = t
+            buf_t[k] = t
+            buf_q[k] = q
+            buf_e[k] = e
+            buf_v[k] = v if v is not None else np.nan
+            k += 1
+            counts['kept'] += 1
+            if k == chunk:
+                yield _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd,
+                             joint_names, t0, counts, notes)
+                k = 0
+        _check_totals(label, topic, counts, missing_seen, min_samples)
+        if k:
+            yield _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd,
+                         joint_names, t0, counts, notes)
+    finally:
+        try:
+            reader.close()
+        except Exception:  # noqa: BLE001, S110 (already failing)
+            pass
+
+
+def _same(a, b):
+    for x, y in zip(a, b):
+        if (x is None) != (y is None):
+            return False
+        if x is not None and not np.array_equal(x, y):
+            return False
+    return True
+
+
+def _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd, names, t0, counts,
+           notes):
+    t = buf_t[:k].copy()
+    return JointStates(
+        stamps=(t - t0) * 1e-9, q=buf_q[:k].copy(),
+        qd=buf_v[:k].copy() if have_qd else None, effort=buf_e[:k].copy(),
+        stamps_ns=t, names=names, t0_ns=t0, counts=dict(counts),
+        notes=list(notes))
+
+
+def _check_totals(label, topic, counts, missing_seen, min_samples):
+    if counts['kept'] >= min_samples:
+        return
+    if counts['kept'] == 0 and counts['missing_joint'] and missing_seen:
+        shown = ', '.join(missing_seen[:4])
+        raise BagError(f'{label}: chain joint(s) {shown} not in the '
+                       f'JointState messages on {topic!r}')
+    if counts['kept'] == 0 and counts['no_effort']:
+        raise BagError(f'{label}: the JointState messages on {topic!r} '
+                       'have no effort field (efforts are needed to '
+                       'identify)')
+    if counts['kept'] == 0 and counts['no_position']:
+        raise BagError(f'{label}: the JointState messages on {topic!r} '
+                       'have no position field')
+    raise BagError(f'{label}: too short: {counts["kept"]} usable samples '
+                   f'on {topic!r}, need at least {min_samples}')
+
+
+def read_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
+                      min_samples=MIN_SAMPLES, chunk=DEFAULT_CHUNK):
+    """
+    Read the whole recording of ``joint_names`` from ``topic``.
+
+    Returns a :class:`JointStates`, which unpacks as
+    ``stamps, q, qd, effort``: stamps (m,) float seconds since the first
+    stamp (``t0_ns``), q (m, n), qd (m, n) or None when the messages carry
+    no velocity, effort (m, n).  Raises :class:`BagError`.
+    """
+    parts = list(iter_joint_states(path, joint_names, topic, chunk=chunk,
+                                   min_samples=min_samples))
+    last = parts[-1]
+    qd = None if any(p.qd is None for p in parts) else np.concatenate(
+        [p.qd for p in parts])
+    return JointStates(
+        stamps=np.concatenate([p.stamps for p in parts]),
+        q=np.concatenate([p.q for p in parts]), qd=qd,
+        effort=np.concatenate([p.effort for p in parts]),
+        stamps_ns=np.concatenate([p.stamps_ns for p in parts]),
+        names=last.names, t0_ns=last.t0_ns, counts=last.counts,
+        notes=last.notes)
+
+
+def write_joint_states(path, stamps_ns, names, q, qd, effort,
+                       topic=DEFAULT_TOPIC, storage='mcap',
+                       logtimes_ns=None):
+    """
+    Write a rosbag2 recording of JointState messages (tests, examples).
+
+    ``stamps_ns`` (m,) integer header stamps; ``q``, ``qd``, ``effort``
+    (m, len(names)) arrays, ``qd`` or ``effort`` None to leave the field
+    empty.  ``storage`` is ``'mcap'`` or ``'sqlite3'``; ``logtimes_ns``
+    the recording times (default: the stamps).  ``path`` must not exist.
+    """
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    JointState = ts.types['sensor_msgs/msg/JointState']
+    Header = ts.types['std_msgs/msg/Header']
+    Time = ts.types['builtin_interfaces/msg/Time']
+    plugin = {'mcap': StoragePlugin.MCAP,
+              'sqlite3': StoragePlugin.SQLITE3}[storage]
+    stamps_ns = np.asarray(stamps_ns, dtype=np.int64)
+    logtimes = stamps_ns if logtimes_ns is None else np.asarray(
+        logtimes_ns, dtype=np.int64)
+    empty = np.zeros(0)
+    names = list(names)
+    with Writer(Path(path), version=9, storage_plugin=plugin) as writer:
+        conn = writer.add_connection(topic, JOINT_STATE, typestore=ts)
+        for i, t in enumerate(stamps_ns):
+            t = int(t)
+            msg = JointState(
+                header=Header(stamp=Time(sec=t // 1_000_000_000,
+                                         nanosec=t % 1_000_000_000),
+                              frame_id=''),
+                name=names,
+                position=np.asarray(q[i], dtype=np.float64),
+                velocity=(empty if qd is None
+                          else np.asarray(qd[i], dtype=np.float64)),
+                effort=(empty if effort is None
+                        else np.asarray(effort[i], dtype=np.float64)))
+            writer.write(conn, int(logtimes[i]),
+                         ts.serialize_cdr(msg, JOINT_STATE))
