@@ -37,6 +37,7 @@ import sys
 
 import numpy as np
 
+from .cli_observe import register as register_observe
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError)
 from .core.robot_file import bundled_robots, Note, read_text, to_number
@@ -405,6 +406,7 @@ def build_parser():
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
+    register_observe(sub)
     return parser
 
 
