@@ -183,3 +183,32 @@ def test_without_effort_the_observer_says_so_and_torques_go_on(graph, puma):
     assert kv['state'].startswith('cannot run'), kv
     log = g['node'].log()
     assert log.count('carry no effort') == 1, log
+
+
+def test_the_payload_is_not_external(graph, puma):
+    """A payload declared at run time leaves the residual, not a contact."""
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    g = graph
+    mass = 3.0
+    result = g['probe'].call(SetParameters, f'{NODE}/set_parameters',
+                             SetParameters.Request(parameters=[
+                                 Parameter('payload.mass', value=mass)
+                                 .to_parameter_msg()])).results[0]
+    assert result.successful, result.reason
+    # the drives now also hold a 3 kg point mass at the tool origin: its
+    # weight is a force the environment applies there (oracle's gravity)
+    weight = np.zeros(6)
+    weight[:3] = mass * np.asarray(puma.gravity)
+    effort = holding_effort(puma, weight)
+    stamps = [send(g, 7000 + k, effort) for k in range(60)]
+    key = (stamps[-1].sec, stamps[-1].nanosec)
+    probe = g['probe']
+
+    def last():
+        return next((m for m in g['ext'] if (m.header.stamp.sec,
+                                             m.header.stamp.nanosec) == key),
+                    None)
+    assert probe.spin_until(lambda: last() is not None, 10.0)
+    assert np.abs(last().effort).max() < 0.3, last().effort
+    assert probe.spin_until(lambda: not g['contact'][-1].data, 3.0)
