@@ -23,6 +23,7 @@ three topics must answer every JointState with its stamp, the wrench
 must come out as the push, and ~/contact must turn true mid-run.
 """
 import os
+import subprocess
 import warnings
 
 import numpy as np
@@ -35,7 +36,7 @@ from geometry_msgs.msg import WrenchStamped  # noqa: E402
 from newton_euler_ros.core import load_robot  # noqa: E402
 import reference_dynamics as ref  # noqa: E402
 from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe)
+                         NodeProcess, Probe, ros_env)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Bool  # noqa: E402
 
@@ -212,3 +213,18 @@ def test_the_payload_is_not_external(graph, puma):
     assert probe.spin_until(lambda: last() is not None, 10.0)
     assert np.abs(last().effort).max() < 0.3, last().effort
     assert probe.spin_until(lambda: not g['contact'][-1].data, 3.0)
+
+
+@pytest.mark.parametrize('args, message', [
+    (['-p', 'observer.thresholds:=[1.0, 2.0]'],
+     'observer.thresholds: must have 1 or 6 values'),
+    (['-p', 'observer.hysteresis:=1.5'], 'observer.hysteresis: must be <= 1'),
+    (['-p', 'observer.gain:=0.0'], 'observer.gain: must be > 0'),
+])
+def test_bad_observer_settings_refuse_to_start(args, message):
+    cmd = id_node_cmd('puma560.yaml', '-p', 'observer.enabled:=true', *args)
+    proc = subprocess.run(cmd, env=ros_env(domain_id(71)),
+                          capture_output=True, text=True, timeout=90)
+    assert proc.returncode == 2, proc.stderr
+    assert message in proc.stderr, proc.stderr
+    assert 'Traceback' not in proc.stderr
