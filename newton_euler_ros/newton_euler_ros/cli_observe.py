@@ -114,7 +114,7 @@ def _finite(name, value, low=None, strict=True):
 def _setup(args):
     """Model (payload included) and observer; _Usage on bad input."""
     from .core import inspect_robot, NewtonEulerError
-    from .core.observer import MomentumObserver
+    from .core.observer import drive_terms, MomentumObserver
     from .feedforward import payload_model
 
     for name in ('gain', 'max_gap'):
@@ -138,7 +138,9 @@ def _setup(args):
             raise ValueError(
                 f'--thresholds: give 1 or {model.n} values (chain order '
                 f'{list(model.joint_names)}), got {len(args.thresholds)}')
+        drive, armature = drive_terms(model)
         obs = MomentumObserver(model, args.gain, max_gap=args.max_gap,
+                               drive_torque=drive, armature=armature,
                                damping=args.damping,
                                thresholds=args.thresholds,
                                hysteresis=args.hysteresis)

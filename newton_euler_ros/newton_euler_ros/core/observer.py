@@ -46,7 +46,8 @@ messages stays reported; a stale residual decays at the rate ``K``).
 
 Functions, one per step: :func:`initial_state`, :func:`observer_step`,
 :func:`external_wrench`, :func:`contact_step`, and
-:func:`observe_recording` over a whole recording.
+:func:`observe_recording` over a whole recording; :func:`drive_terms`
+takes the drive friction and rotor inertia from a model that has them.
 
 Signs and frames.  The residual is the joint torque the environment
 applies, ``tau_ext = J^T F_ext``.  :func:`external_wrench` returns
@@ -306,6 +307,30 @@ class MomentumObserver:
         observer_step(self, state, 1e-3, z, z, z)
         external_wrench(self, z, state.r)
         contact_step(self, initial_contact(self), state.r)
+
+
+def drive_terms(model):
+    """
+    Return ``(drive_torque, armature)`` from the drives a model carries.
+
+    A model read from a URDF with identified drives (friction, offset,
+    rotor inertia) carries them as ``model.info['drives']``, an object
+    with ``torques(qd, qdd)`` and ``armature``; the friction and offset
+    are what the drives lose (``drive_torque``, called with qdd None) and
+    the rotor inertia goes into the momentum.  ``(None, None)`` when the
+    model has none.
+    """
+    info = getattr(model, 'info', None) or {}
+    drives = info.get('drives') if isinstance(info, dict) else None
+    if drives is None or not callable(getattr(drives, 'torques', None)):
+        return None, None
+    zero = np.zeros(model.n)
+
+    def drive_torque(qd, _qdd=None):
+        return drives.torques(qd, zero)
+
+    armature = getattr(drives, 'armature', None)
+    return drive_torque, armature
 
 
 @dataclass

@@ -580,7 +580,8 @@ class InverseDynamicsNode(Node):
         p = self.params
         model = ff.model
         scene = ff.scene
-        drive = armature = None
+        # the model's own drives (an identified URDF), or the scene's
+        drive, armature = momentum.drive_terms(model)
         if scene is not None and scene.effects.friction:
             drive = functools.partial(_scene_friction, scene)
         if scene is not None and scene.effects.armature:

@@ -27,7 +27,8 @@ import warnings
 
 from newton_euler_ros.core import load_robot, RobotFileWarning
 from newton_euler_ros.core.errors import DynamicsInputError
-from newton_euler_ros.core.observer import (contact_step, DUPLICATE,
+from newton_euler_ros.core.observer import (contact_step, drive_terms,
+                                            DUPLICATE,
                                             external_wrench,
                                             felt_directions, initial_contact,
                                             initial_state, MomentumObserver,
@@ -280,6 +281,30 @@ def test_drive_friction_is_not_external(panda):
     out = observe_recording(obs, t, Q, QD, TAU)
     assert not out.contact.any()
     assert np.abs(out.residual[200:]).max() < 0.05
+
+
+def test_drives_carried_by_the_model_are_used(panda):
+    """An identified model's drives (model.info['drives']) plug in."""
+    from types import SimpleNamespace
+    model, peer = panda
+    t = np.arange(0.0, 1.5, 1e-3)
+    viscous, offset, armature = np.full(7, 0.3), np.full(7, 0.2), \
+        np.full(7, 0.05)
+
+    def torques(qd, qdd):
+        return viscous * qd + offset + armature * qdd
+
+    drives = SimpleNamespace(torques=torques, armature=armature)
+    info = dict(model.info, drives=drives)
+    identified = model.replace(info=info)
+    lost, arm = drive_terms(identified)
+    assert drive_terms(model) == (None, None)
+    Q, QD, QDD = path(t)
+    _, _, TAU = record(peer, t)
+    TAU = TAU + torques(QD, QDD)
+    out = observe_recording(MomentumObserver(model, drive_torque=lost,
+                                             armature=arm), t, Q, QD, TAU)
+    assert np.abs(out.residual[200:]).max() < 0.02
 
 
 def test_armature_enters_the_momentum(panda):
