@@ -50,6 +50,7 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_trajectory
 	$(PY) -m newton_euler_tools.bench_scaling
 	$(PY) -m newton_euler_tools.bench_regressor
+	$(PY) -m newton_euler_tools.bench_observer
 
 # identification: 40 s recording time; 1 and 30 min time and peak memory
 # (about 10 minutes: writing and reading the 30 min bag dominates)

@@ -38,6 +38,7 @@ import sys
 import numpy as np
 
 from .cli_identify import register as register_identify
+from .cli_observe import register as register_observe
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
                    RobotFileError)
@@ -415,6 +416,7 @@ def build_parser():
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
     register_identify(sub)
+    register_observe(sub)
     return parser
 
 

@@ -1,0 +1,258 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+``newton-euler observe``: the momentum observer over a recorded bag.
+
+    newton-euler observe MODEL.urdf BAG --base LINK --tip LINK --csv OUT.csv
+                         [--plot OUT.png] [--topic T] [--gain K]
+                         [--thresholds T [T ...]] [--hysteresis H]
+                         [--damping L] [--max-gap S]
+                         [--payload-mass M] [--payload-com X Y Z]
+
+The same observer as inverse_dynamics_node's ``observer.*`` parameters
+(:mod:`newton_euler_ros.core.observer`), run over the JointStates of a
+rosbag2 recording (MCAP or sqlite3), so that gain and thresholds can be
+tuned on one's own recording before turning it on.  Writes one CSV row
+per sample (time, external torque per joint, external wrench, contact)
+and, with ``--plot``, a PNG; both are written atomically.  Prints a
+summary with each joint's largest |external torque|, from which to set
+the thresholds when the recording is free motion (docs/observer.md).
+"""
+import math
+import os
+import sys
+import tempfile
+
+import numpy as np
+
+WRENCH_COLUMNS = ('fx', 'fy', 'fz', 'mx', 'my', 'mz')
+
+
+class _Usage(Exception):
+    """A bad input: one line, exit status 2."""
+
+
+def register(subparsers):
+    """Add the ``observe`` command to the ``newton-euler`` parser."""
+    obs = subparsers.add_parser(
+        'observe', help='run the momentum observer (external torque, '
+                        'wrench, contact) over a recorded bag')
+    obs.add_argument('robot', help='URDF (or robot YAML) file, or bundled '
+                                   'robot name')
+    obs.add_argument('bag', help='rosbag2 directory (MCAP or sqlite3) with '
+                                 'sensor_msgs/JointState')
+    obs.add_argument('--base', metavar='LINK',
+                     help='URDF only: first link of the chain (default: '
+                          'the root link)')
+    obs.add_argument('--tip', metavar='LINK',
+                     help='URDF only: last link, the end effector '
+                          '(default: the single leaf)')
+    obs.add_argument('--csv', metavar='OUT.csv', required=True,
+                     help='write one row per sample here')
+    obs.add_argument('--plot', metavar='OUT.png',
+                     help='also plot external torques and wrench')
+    obs.add_argument('--topic', default='/joint_states',
+                     help='JointState topic (default /joint_states)')
+    obs.add_argument('--gain', type=float, default=50.0, metavar='K',
+                     help='observer gain, 1/s (default 50)')
+    obs.add_argument('--thresholds', type=float, nargs='+', default=[10.0],
+                     metavar='T', help='contact threshold per joint in '
+                     'chain order, or one for all (N m or N; default 10)')
+    obs.add_argument('--hysteresis', type=float, default=0.5,
+                     help='release below this fraction of the threshold '
+                          '(default 0.5)')
+    obs.add_argument('--damping', type=float, default=0.01,
+                     help='damping of the least-squares wrench (default '
+                          '0.01)')
+    obs.add_argument('--max-gap', type=float, default=0.1, metavar='S',
+                     help='restart the integral after a gap longer than '
+                          'this (s, default 0.1)')
+    obs.add_argument('--payload-mass', type=float, default=0.0,
+                     metavar='KG', help='payload on the end effector, kg')
+    obs.add_argument('--payload-com', type=float, nargs=3,
+                     default=[0.0, 0.0, 0.0], metavar=('X', 'Y', 'Z'),
+                     help='payload centre of mass, end-effector frame, m')
+    obs.set_defaults(func=cmd_observe)
+
+
+def _atomic_write(path, write, mode='w'):
+    """Write ``path`` through a temporary file in its folder, then rename."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise _Usage(f'{path}: folder {folder} does not exist')
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix='.' + os.path.basename(
+        path), suffix='.tmp')
+    try:
+        with os.fdopen(fd, mode) as fh:
+            write(fh)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def _finite(name, value, low=None, strict=True):
+    if not math.isfinite(value) or (low is not None and (
+            value <= low if strict else value < low)):
+        bound = '' if low is None else f' {">" if strict else ">="} {low}'
+        raise _Usage(f'{name}: must be finite{bound}, got {value}')
+
+
+def _setup(args):
+    """Model (payload included) and observer; _Usage on bad input."""
+    from .core import inspect_robot, NewtonEulerError
+    from .core.observer import drive_terms, MomentumObserver
+    from .feedforward import payload_model
+
+    for name in ('gain', 'max_gap'):
+        _finite(f'--{name.replace("_", "-")}', getattr(args, name), 0.0)
+    _finite('--damping', args.damping, 0.0, strict=False)
+    _finite('--hysteresis', args.hysteresis, 0.0)
+    for opt, path in (('--csv', args.csv), ('--plot', args.plot)):
+        if path and os.path.isdir(path):
+            raise _Usage(f'{opt} {path}: is a directory')
+    try:
+        model, found, _ = inspect_robot(args.robot, base=args.base,
+                                        tip=args.tip)
+    except NewtonEulerError as exc:
+        raise _Usage(str(exc)) from None
+    for message in found:
+        print(f'warning: {message}', file=sys.stderr)
+    try:
+        model = payload_model(model, args.payload_mass, args.payload_com,
+                              [0.0] * 6)
+        if len(args.thresholds) not in (1, model.n):
+            raise ValueError(
+                f'--thresholds: give 1 or {model.n} values (chain order '
+                f'{list(model.joint_names)}), got {len(args.thresholds)}')
+        drive, armature = drive_terms(model)
+        obs = MomentumObserver(model, args.gain, max_gap=args.max_gap,
+                               drive_torque=drive, armature=armature,
+                               damping=args.damping,
+                               thresholds=args.thresholds,
+                               hysteresis=args.hysteresis)
+    except ValueError as exc:
+        raise _Usage(str(exc).replace('payload.', '--payload-')) from None
+    return model, obs
+
+
+def cmd_observe(args):
+    """Run the observer over the bag; write the CSV (and the plot)."""
+    try:
+        return _observe(args)
+    except _Usage as exc:
+        print(f'newton-euler: error: {exc}', file=sys.stderr)
+        return 2
+
+
+def _observe(args):
+    from .core.observer import observe_recording
+    from .ident.bag import BagError, read_joint_states
+
+    model, obs = _setup(args)
+    try:
+        rec = read_joint_states(args.bag, model.joint_names, args.topic,
+                                min_samples=2)
+    except BagError as exc:
+        raise _Usage(str(exc)) from None
+    if rec.qd is None:
+        raise _Usage(f'{args.bag}: the JointState messages on '
+                     f'{args.topic!r} have no velocity (the observer needs '
+                     f'joint velocities)')
+    out = observe_recording(obs, rec.stamps, rec.q, rec.qd, rec.effort)
+    names = list(model.joint_names)
+    _atomic_write(args.csv, lambda fh: _write_csv(fh, rec, out, names))
+    lines = _summary(args, model, rec, out)
+    if args.plot:
+        _plot(args.plot, rec.stamps, names, out, obs.thresholds)
+    print('\n'.join(lines))
+    print(f'wrote {args.csv}' + (f' and {args.plot}' if args.plot else ''))
+    return 0
+
+
+def _write_csv(fh, rec, out, names):
+    fh.write(','.join(['time', 'stamp_ns'] + [f'tau_ext_{j}' for j in names]
+                      + list(WRENCH_COLUMNS) + ['contact']) + '\n')
+    for k in range(len(out.t)):
+        row = [f'{out.t[k]:.9f}', str(int(rec.stamps_ns[k]))]
+        row += [f'{x:.6g}' for x in out.residual[k]]
+        row += [f'{x:.6g}' for x in out.wrench[k]]
+        row.append('1' if out.contact[k] else '0')
+        fh.write(','.join(row) + '\n')
+
+
+def _summary(args, model, rec, out):
+    t = out.t
+    peak = np.abs(out.residual).max(axis=0)
+    rms = np.sqrt((out.residual ** 2).mean(axis=0))
+    thresholds = np.resize(np.asarray(args.thresholds, float), model.n)
+    lines = [
+        f'{model.name}: {len(t)} samples over {t[-1] - t[0]:.3f} s from '
+        f'{args.bag} ({args.topic}); gain {args.gain:g} 1/s, '
+        f'{out.restarts} restart(s), {out.skipped} sample(s) skipped',
+        f'contacts: {out.contacts} (in contact {out.contact.mean():.1%} of '
+        f'samples)',
+        f'{"joint":<24}{"threshold":>11}{"max |tau_ext|":>15}'
+        f'{"rms":>10}{"suggested":>11}']
+    for j, name in enumerate(model.joint_names):
+        lines.append(f'{name:<24}{thresholds[j]:>11.3g}{peak[j]:>15.3g}'
+                     f'{rms[j]:>10.3g}{_suggest(peak[j]):>11.3g}')
+    lines.append('suggested = 1.5 x max |tau_ext| (valid when the recording '
+                 'is free motion, no contact)')
+    for note in getattr(rec, 'notes', []):
+        lines.append(f'note: {note}')
+    return lines
+
+
+def _suggest(peak):
+    """Return a threshold above a free-motion peak: 1.5 x, 2 digits."""
+    x = 1.5 * peak
+    if x <= 0.0:
+        return 0.1
+    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
+    return math.ceil(x / scale) * scale
+
+
+def _plot(path, t, names, out, thresholds):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(10, 8))
+    ax = axes[0]
+    for j, name in enumerate(names):
+        line, = ax.plot(t, out.residual[:, j], lw=0.8, label=name)
+        ax.axhline(thresholds[j], color=line.get_color(), lw=0.5, ls=':')
+        ax.axhline(-thresholds[j], color=line.get_color(), lw=0.5, ls=':')
+    ax.set_ylabel('external torque\n(N m or N)')
+    ax.legend(fontsize=7, ncol=4, loc='upper right')
+    for ax, cols, unit in ((axes[1], slice(0, 3), 'force (N)'),
+                           (axes[2], slice(3, 6), 'moment (N m)')):
+        for c, label in zip(range(cols.start, cols.stop),
+                            WRENCH_COLUMNS[cols]):
+            ax.plot(t, out.wrench[:, c], lw=0.8, label=label)
+        ax.set_ylabel(f'external {unit}\n(base axes)')
+        ax.legend(fontsize=7, ncol=3, loc='upper right')
+    for ax in axes:
+        ax.fill_between(t, 0, 1, where=out.contact, color='tab:red',
+                        alpha=0.12, transform=ax.get_xaxis_transform(),
+                        label=None)
+    axes[-1].set_xlabel('time since the first sample (s); red: contact')
+    fig.suptitle('momentum observer: what the environment applies')
+    fig.tight_layout()
+    _atomic_write(path, lambda fh: fig.savefig(fh, format='png', dpi=110),
+                  'wb')
+    plt.close(fig)

@@ -1,0 +1,530 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Generalized-momentum observer: external joint torque, wrench and contact.
+
+With the generalized momentum ``p = D(q) qd`` and ``Ddot = C + C^T``, the
+equation of motion ``D qdd + C qd + g = tau + tau_ext`` gives
+``pdot = tau + tau_ext + C^T qd - g``.  The residual
+
+    r(t) = K [p(t) - p(0) - integral_0^t (tau + C^T qd - g + r) ds]
+
+obeys ``rdot = K (tau_ext - r)``: a first-order low-pass of the external
+joint torque with gain ``K`` (1/s), needing no acceleration and no
+differentiation (De Luca and Mattone, ICRA 2005; Haddadin, De Luca and
+Albu-Schaeffer, T-RO 2017).  ``tau`` is what the drives apply (the
+JointState effort); what the model knows is not external is taken out
+first: the drive friction (``drive_torque``) and the rotor inertia
+(``armature``, added to the momentum); the payload is part of the model.
+
+Discretization.  Between two samples the running sum
+``S = p(0) + integral (tau + C^T qd - g + r) ds`` advances with the
+trapezoid rule for the known torques and the exact integral of ``r``
+for a constant external torque over the interval, so that
+``r = K (p - S)`` holds at every sample and the residual is the exact
+first-order lag of the interval's mean external torque, whatever the
+step: ``r_k = a r_(k-1) + (1 - a) u_k`` with ``a = exp(-K dt)``.  Only
+``S``, ``r`` and the previous known torque are carried: no history.
+
+Stamps.  Time is the samples' stamps (seconds), not their count.  A
+sample with the same stamp as the previous one is ignored; a gap longer
+than ``max_gap`` or a stamp going backwards restarts the sum at the new
+sample, keeping the residual (a contact held through a lost burst of
+messages stays reported; a stale residual decays at the rate ``K``).
+
+Functions, one per step: :func:`initial_state`, :func:`observer_step`,
+:func:`external_wrench`, :func:`contact_step`, and
+:func:`observe_recording` over a whole recording; :func:`drive_terms`
+takes the drive friction and rotor inertia from a model that has them.
+
+Signs and frames.  The residual is the joint torque the environment
+applies, ``tau_ext = J^T F_ext``.  :func:`external_wrench` returns
+``F_ext = [f; m]``, the wrench the environment applies *to* the end
+effector (a wrist force/torque sensor's sign), in base-frame axes, the
+moment about the end-effector origin.  It is the opposite of the
+dynamics' input ``F_e`` (the wrench the end effector exerts, which adds
+``+J^T F_e`` to the torques): ``F_ext = -F_e``.  It is the damped
+least-squares solution of ``J^T F = r``, ``F = (J J^T + lambda^2 I)^-1
+J r``: with fewer than six joints (or at a singularity) only its
+component in the range of ``J`` (the directions in which the end
+effector can move, and so can feel a push) is estimated; the rest is
+reported as zero (:func:`felt_directions` gives that range).
+"""
+from dataclasses import dataclass, field
+import math
+
+from numba import njit
+import numpy as np
+
+from .dynamics import coriolis_matrix, gravity_torques, jacobian, mass_matrix
+from .errors import DynamicsInputError
+from .workspace import Workspace
+
+#: what :func:`observer_step` did with a sample
+UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \
+    'restarted', 'duplicate'
+
+
+# ---------------------------------------------------------------------------
+# compiled arithmetic (no allocation, finiteness checked here)
+
+@njit(cache=True)
+def _update(D, C, g, qd, tau, lost, armature, gain, dt, restart, p, beta,
+            beta_prev, S, r):
+    """
+    One sample: p, beta, then S and r advanced over dt (or restarted).
+
+    p = (D + diag(armature)) qd and beta = tau - lost + C^T qd - g are
+    formed first; if one is not finite the state is left untouched and
+    the joint's index returned.  Otherwise S and r advance over ``dt``
+    (or, with ``restart``, S starts at this sample keeping r) and -1 is
+    returned (-2 if r came out non-finite and was reset to 0).
+    """
+    n = qd.shape[0]
+    for i in range(n):
+        s = armature[i] * qd[i]
+        c = 0.0
+        for j in range(n):
+            s += D[i, j] * qd[j]
+            c += C[j, i] * qd[j]
+        p[i] = s
+        beta[i] = tau[i] - lost[i] + c - g[i]
+        if not (math.isfinite(p[i]) and math.isfinite(beta[i])):
+            return i
+    ok = True
+    if not restart:
+        for i in range(n):
+            k = gain[i]
+            a = math.exp(-k * dt)
+            b = 1.0 - a
+            known = 0.5 * dt * (beta[i] + beta_prev[i])
+            # mean external torque over the interval: the momentum
+            # change that the known torques do not explain
+            u = (p[i] - (S[i] + r[i] / k) - known) / dt
+            S[i] += known + r[i] * b / k + u * (dt - b / k)
+            r[i] = a * r[i] + b * u
+            ok &= math.isfinite(r[i]) and math.isfinite(S[i])
+    for i in range(n):
+        if not ok or not math.isfinite(r[i]):
+            r[i] = 0.0          # cannot happen for finite input; never
+        if restart or not ok:   # hand out NaN
+            S[i] = p[i] - r[i] / gain[i]
+        beta_prev[i] = beta[i]
+    return -1 if ok else -2
+
+
+@njit(cache=True)
+def _cholesky_solve(A, x):
+    """Solve A y = x in place (A symmetric, lower triangle used)."""
+    m = x.shape[0]
+    for a in range(m):
+        for b in range(a + 1):
+            s = A[a, b]
+            for c in range(b):
+                s -= A[a, c] * A[b, c]
+            if a == b:
+                if not s > 0.0:
+                    return False
+                A[a, a] = math.sqrt(s)
+            else:
+                A[a, b] = s / A[b, b]
+    for a in range(m):
+        s = x[a]
+        for c in range(a):
+            s -= A[a, c] * x[c]
+        x[a] = s / A[a, a]
+    for a in range(m - 1, -1, -1):
+        s = x[a]
+        for c in range(a + 1, m):
+            s -= A[c, a] * x[c]
+        x[a] = s / A[a, a]
+    return True
+
+
+@njit(cache=True)
+def _dls_wrench(J, r, damping, A, y, F):
+    """
+    F = (J J^T + damping^2 I)^-1 J r, the damped (J^T)^+ r.
+
+    Six joints or more: the 6 x 6 system.  Fewer: the same F as
+    J (J^T J + damping^2 I)^-1 r, an n x n system that stays well
+    conditioned when J J^T is singular.
+    """
+    n = r.shape[0]
+    lam2 = damping * damping
+    if n >= 6:
+        for a in range(6):
+            s = 0.0
+            for j in range(n):
+                s += J[a, j] * r[j]
+            y[a] = s
+            for b in range(a + 1):
+                s = 0.0
+                for j in range(n):
+                    s += J[a, j] * J[b, j]
+                A[a, b] = s
+            A[a, a] += lam2
+        if not _cholesky_solve(A, y):
+            return False
+        for a in range(6):
+            F[a] = y[a]
+    else:
+        for a in range(n):
+            y[a] = r[a]
+            for b in range(a + 1):
+                s = 0.0
+                for c in range(6):
+                    s += J[c, a] * J[c, b]
+                A[a, b] = s
+            A[a, a] += lam2
+        if not _cholesky_solve(A, y):
+            return False
+        for c in range(6):
+            s = 0.0
+            for a in range(n):
+                s += J[c, a] * y[a]
+            F[c] = s
+    for a in range(6):
+        if not math.isfinite(F[a]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _contact(r, on, hysteresis, active):
+    """Per-joint hysteresis; True when any joint is in contact."""
+    any_active = False
+    for i in range(r.shape[0]):
+        x = abs(r[i])
+        if active[i]:
+            active[i] = x > hysteresis * on[i]
+        else:
+            active[i] = x > on[i]
+        any_active |= active[i]
+    return any_active
+
+
+# ---------------------------------------------------------------------------
+# configuration and state
+
+def _per_joint(name, value, n, positive=True):
+    x = np.array(value, dtype=np.float64).reshape(-1)
+    if x.size == 1:
+        x = np.full(n, x[0])
+    if x.size != n:
+        raise ValueError(f'{name}: must have 1 or {n} values (one per '
+                         f'joint), got {x.size}')
+    low = (x <= 0.0) if positive else (x < 0.0)
+    if not np.isfinite(x).all() or low.any():
+        raise ValueError(f'{name}: must be finite and '
+                         f'{"> 0" if positive else ">= 0"}, got '
+                         f'{x.tolist()}')
+    return np.ascontiguousarray(x)
+
+
+class MomentumObserver:
+    """
+    The observer's configuration and reusable buffers for one model.
+
+    Parameters
+    ----------
+    model : the robot model, payload included (``payload_model``).
+    gain : K in 1/s, one value or one per joint (20 to 100 is typical):
+        the residual follows the external torque with time constant 1/K.
+    max_gap : seconds; a longer interval between samples restarts the
+        sum (as does a stamp going backwards).
+    drive_torque : optional callable ``(qd, qdd_or_None) -> tau_lost``,
+        the torque the drives lose to friction (model order); called with
+        ``qdd=None`` (the observer has no acceleration).
+    armature : optional per-joint reflected rotor inertia, added to the
+        diagonal of D in the momentum.
+    damping : lambda of the damped least-squares wrench (same units as
+        J: metres and 1); larger trades accuracy near singularities for
+        a bounded estimate.
+    thresholds : per-joint contact thresholds on |r| (N m or N), one
+        value or one per joint (model order).
+    hysteresis : a joint in contact is released when |r| falls below
+        this fraction of its threshold (0 < hysteresis <= 1).
+    ws : a :class:`Workspace` of the model (a new one by default); not
+        shared with another thread.
+
+    """
+
+    def __init__(self, model, gain=50.0, *, max_gap=0.1, drive_torque=None,
+                 armature=None, damping=0.01, thresholds=10.0,
+                 hysteresis=0.5, ws=None):
+        n = model.n
+        self.model = model
+        self.n = n
+        self.gain = _per_joint('gain', gain, n)
+        self.max_gap = float(max_gap)
+        if not (math.isfinite(self.max_gap) and self.max_gap > 0.0):
+            raise ValueError(f'max_gap: must be finite and > 0, got '
+                             f'{max_gap!r}')
+        if drive_torque is not None and not callable(drive_torque):
+            raise ValueError('drive_torque: must be callable '
+                             '(qd, qdd_or_None) -> torque')
+        self.drive_torque = drive_torque
+        self.armature = (np.zeros(n) if armature is None else
+                         _per_joint('armature', armature, n, positive=False))
+        self.damping = float(damping)
+        if not (math.isfinite(self.damping) and self.damping >= 0.0):
+            raise ValueError(f'damping: must be finite and >= 0, got '
+                             f'{damping!r}')
+        self.thresholds = _per_joint('thresholds', thresholds, n)
+        self.hysteresis = float(hysteresis)
+        if not (0.0 < self.hysteresis <= 1.0):
+            raise ValueError(f'hysteresis: must be in (0, 1], got '
+                             f'{hysteresis!r}')
+        self.ws = Workspace(model) if ws is None else ws
+        self.D = np.zeros((n, n))
+        self.C = np.zeros((n, n))
+        self.g = np.zeros(n)
+        self.J = np.zeros((6, n))
+        self.p = np.zeros(n)
+        self.beta = np.zeros(n)
+        self.lost = np.zeros(n)
+        self._A = np.zeros((min(n, 6), min(n, 6)))
+        self._y = np.zeros(min(n, 6))
+
+    def warm_up(self):
+        """Compile (or load) every kernel once, before the first sample."""
+        z = np.zeros(self.n)
+        state = initial_state(self)
+        observer_step(self, state, 0.0, z, z, z)
+        observer_step(self, state, 1e-3, z, z, z)
+        external_wrench(self, z, state.r)
+        contact_step(self, initial_contact(self), state.r)
+
+
+def drive_terms(model):
+    """
+    Return ``(drive_torque, armature)`` from the drives a model carries.
+
+    A model read from a URDF with identified drives (friction, offset,
+    rotor inertia) carries them as ``model.info['drives']``, an object
+    with ``torques(qd, qdd)`` and ``armature``; the friction and offset
+    are what the drives lose (``drive_torque``, called with qdd None) and
+    the rotor inertia goes into the momentum.  ``(None, None)`` when the
+    model has none.
+    """
+    info = getattr(model, 'info', None) or {}
+    drives = info.get('drives') if isinstance(info, dict) else None
+    if drives is None or not callable(getattr(drives, 'torques', None)):
+        return None, None
+    zero = np.zeros(model.n)
+
+    def drive_torque(qd, _qdd=None):
+        return drives.torques(qd, zero)
+
+    armature = getattr(drives, 'armature', None)
+    return drive_torque, armature
+
+
+@dataclass
+class ObserverState:
+    """What the observer carries between samples: no history."""
+
+    S: np.ndarray           # running sum p(0) + integral, model order
+    r: np.ndarray           # residual (external joint torque estimate)
+    beta_prev: np.ndarray   # known torque at the previous sample
+    t_prev: float = None    # stamp of the previous sample (None: none)
+    samples: int = 0        # samples used
+    restarts: int = 0       # gaps and stamps going backwards
+    duplicates: int = 0     # samples with the previous sample's stamp
+
+
+@dataclass
+class ContactState:
+    """Per-joint contact flags, the overall flag and the contact count."""
+
+    active: np.ndarray
+    in_contact: bool = False
+    count: int = 0          # contacts begun (false -> true)
+
+
+def initial_state(obs):
+    """Return a state before any sample: the first one starts the sum."""
+    n = obs.n
+    return ObserverState(np.zeros(n), np.zeros(n), np.zeros(n))
+
+
+def initial_contact(obs):
+    """Return a contact state with no joint in contact."""
+    return ContactState(np.zeros(obs.n, dtype=np.bool_))
+
+
+def observer_step(obs, state, t, q, qd, tau):
+    """
+    Use one sample at stamp ``t`` (seconds); return the residual.
+
+    ``q``, ``qd``, ``tau`` (efforts) are float64 arrays in model order.
+    Returns ``(r, what)`` with ``r`` the state's residual (a view, updated
+    in place; copy to keep it) and ``what`` one of ``UPDATED``,
+    ``STARTED`` (first sample), ``RESTARTED`` (gap or stamp backwards),
+    ``DUPLICATE`` (same stamp: ignored).  Non-finite or wrongly sized
+    input raises :class:`DynamicsInputError` and leaves the state as it
+    was.
+    """
+    t = float(t)
+    if not math.isfinite(t):
+        raise DynamicsInputError(f'stamp must be finite, got {t!r}')
+    dt = None if state.t_prev is None else t - state.t_prev
+    if dt == 0.0:
+        state.duplicates += 1
+        return state.r, DUPLICATE
+    m = obs.model
+    ws = obs.ws
+    mass_matrix(m, q, ws=ws, out=obs.D)
+    coriolis_matrix(m, q, qd, ws=ws, out=obs.C)
+    gravity_torques(m, q, ws=ws, out=obs.g)
+    qd = _vector('qd', qd, obs.n)
+    tau = _vector('tau', tau, obs.n)
+    if obs.drive_torque is not None:
+        lost = _vector('drive_torque', obs.drive_torque(qd, None), obs.n)
+    else:
+        lost = obs.lost
+    restart = dt is None or dt < 0.0 or dt > obs.max_gap
+    bad = _update(obs.D, obs.C, obs.g, qd, tau, lost, obs.armature,
+                  obs.gain, 0.0 if restart else dt, restart, obs.p, obs.beta,
+                  state.beta_prev, state.S, state.r)
+    if bad >= 0:
+        raise DynamicsInputError(
+            f'non-finite momentum or torque at joint '
+            f'{m.joint_names[bad]!r} (effort {float(tau[bad])!r})')
+    if not restart:
+        what = UPDATED
+    elif dt is None:
+        what = STARTED
+    else:
+        what = RESTARTED
+        state.restarts += 1
+    state.t_prev = t
+    state.samples += 1
+    return state.r, what
+
+
+def _vector(name, x, n):
+    if isinstance(x, np.ndarray) and x.dtype == np.float64 and \
+            x.shape == (n,) and x.flags.c_contiguous:
+        return x
+    try:
+        x = np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DynamicsInputError(f'{name}: must be {n} numbers') from None
+    if x.shape != (n,):
+        raise DynamicsInputError(f'{name}: must have {n} values, got '
+                                 f'shape {x.shape}')
+    return x
+
+
+def external_wrench(obs, q, r, out=None):
+    """
+    Return F_ext (6,), the wrench the environment applies to the tool.
+
+    ``[fx, fy, fz, mx, my, mz]`` in base axes, moment about the
+    end-effector origin (force/torque sensor sign; ``-F_e`` of the
+    dynamics' input convention), the damped least-squares solution of
+    ``J(q)^T F = r``.  Zeros if the solve fails (never NaN).
+    """
+    J = jacobian(obs.model, q, 'base', ws=obs.ws, out=obs.J)
+    F = np.empty(6) if out is None else out
+    if not _dls_wrench(J, _vector('r', r, obs.n), obs.damping, obs._A,
+                       obs._y, F):
+        F[:] = 0.0
+    return F
+
+
+def contact_step(obs, contact, r):
+    """Update ``contact`` from the residual; return whether in contact."""
+    now = _contact(r, obs.thresholds, obs.hysteresis, contact.active)
+    if now and not contact.in_contact:
+        contact.count += 1
+    contact.in_contact = bool(now)
+    return contact.in_contact
+
+
+def felt_directions(obs, q, tol=1e-6):
+    """
+    Return an orthonormal basis (6, k) of the wrenches the arm feels at q.
+
+    The range of J(q) (``[f; m]`` in base axes, moment about the
+    end-effector origin): the estimate of :func:`external_wrench` is the
+    projection of the true wrench onto it (for small damping).  ``k`` is
+    6 for a six- or seven-joint arm away from singularities; a planar
+    three-joint arm feels fx, fy and mz; a planar two-joint arm only two
+    combinations of them.  Columns with singular values below ``tol``
+    times the largest are left out.
+    """
+    J = jacobian(obs.model, q, 'base', ws=obs.ws)
+    U, s, _ = np.linalg.svd(J, full_matrices=False)
+    if not s.size or not s[0] > 0.0:
+        return np.zeros((6, 0))
+    return U[:, s > tol * s[0]]
+
+
+@dataclass
+class ObserverRecording:
+    """The observer over a recording, one row per sample."""
+
+    t: np.ndarray                   # (m,) stamps, seconds
+    residual: np.ndarray            # (m, n) external joint torque
+    wrench: np.ndarray              # (m, 6) F_ext, base axes
+    contact: np.ndarray             # (m,) bool
+    status: list = field(default_factory=list)   # what each sample did
+    contacts: int = 0               # contacts begun
+    restarts: int = 0
+    skipped: int = 0                # rows with non-finite input
+
+
+def observe_recording(obs, T, Q, QD, TAU):
+    """
+    Run the observer over a recording: stamps T (m,), Q, QD, TAU (m, n).
+
+    Rows are used in the given order, exactly as live samples would be
+    (gaps and stamps going backwards restart the sum).  A row with a
+    non-finite value is skipped as a lost message: its output holds the
+    previous values.  Returns an :class:`ObserverRecording`.
+    """
+    T = np.asarray(T, dtype=np.float64).reshape(-1)
+    m, n = T.shape[0], obs.n
+    arrays = []
+    for name, X in (('Q', Q), ('QD', QD), ('TAU', TAU)):
+        X = np.ascontiguousarray(X, dtype=np.float64)
+        if X.shape != (m, n):
+            raise ValueError(f'{name}: must have shape ({m}, {n}), got '
+                             f'{X.shape}')
+        arrays.append(X)
+    Q, QD, TAU = arrays
+    out = ObserverRecording(T.copy(), np.zeros((m, n)), np.zeros((m, 6)),
+                            np.zeros(m, dtype=np.bool_), [])
+    state, contact = initial_state(obs), initial_contact(obs)
+    F = np.zeros(6)
+    for k in range(m):
+        try:
+            r, what = observer_step(obs, state, T[k], Q[k], QD[k], TAU[k])
+            if what != DUPLICATE:
+                external_wrench(obs, Q[k], r, out=F)
+                contact_step(obs, contact, r)
+        except DynamicsInputError:
+            out.skipped += 1
+            what = 'skipped'
+        out.residual[k] = state.r
+        out.wrench[k] = F
+        out.contact[k] = contact.in_contact
+        out.status.append(what)
+    out.contacts = contact.count
+    out.restarts = state.restarts
+    return out

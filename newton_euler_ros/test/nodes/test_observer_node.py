@@ -1,0 +1,230 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The node's momentum observer over real DDS.
+
+inverse_dynamics_node (bundled puma560, observer.enabled) is fed
+JointStates whose efforts hold the arm still at a pose, from the
+Euler-Lagrange oracle: first free, then while the environment pushes on
+the tool with a known wrench (the drives then apply g - J^T F_ext).  The
+three topics must answer every JointState with its stamp, the wrench
+must come out as the push, and ~/contact must turn true mid-run.
+"""
+import os
+import subprocess
+import warnings
+
+import numpy as np
+import pytest
+
+pytest.importorskip('rclpy')
+
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+from newton_euler_ros.core import load_robot  # noqa: E402
+import reference_dynamics as ref  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe, ros_env)
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import Bool  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+NODE = '/inverse_dynamics_node'
+NAMES = ['joint1', 'joint2', 'joint3', 'joint4', 'joint5', 'joint6']
+Q = np.array([0.2, -0.5, 0.3, 0.1, 0.4, 0.2])
+PUSH = np.array([0.0, 20.0, -30.0, 0.0, 0.0, 0.0])   # on the tool, N
+
+
+@pytest.fixture(scope='module')
+def graph(tmp_path_factory):
+    tmp = str(tmp_path_factory.mktemp('observer'))
+    domain = domain_id(73)
+    cmd = id_node_cmd('puma560.yaml', '-p', 'observer.enabled:=true',
+                      '-p', 'observer.gain:=50.0',
+                      '-p', 'observer.thresholds:=[3.0]',
+                      '-p', 'observer.contact_period:=0.2',
+                      '-p', 'diagnostics_period:=0.2')
+    node = NodeProcess(cmd, domain, os.path.join(tmp, 'node.log'))
+    probe = Probe(domain)
+    g = {'node': node, 'probe': probe,
+         'torques': probe.collect(JointState, f'{NODE}/torques', 1000),
+         'ext': probe.collect(JointState, f'{NODE}/external_torque', 1000),
+         'wrench': probe.collect(WrenchStamped, f'{NODE}/external_wrench',
+                                 1000),
+         'contact': probe.collect(Bool, f'{NODE}/contact', 1000),
+         'diag': probe.collect(DiagnosticArray, '/diagnostics'),
+         'js': probe.publisher(JointState, 'joint_states', 1000)}
+    ok = probe.spin_until(
+        lambda: g['js'].get_subscription_count() > 0 and all(
+            probe.node.count_publishers(f'{NODE}/{t}') > 0
+            for t in ('torques', 'external_torque', 'external_wrench',
+                      'contact')), 90.0)
+    assert ok, node.log()
+    yield g
+    node.stop()
+    probe.close()
+
+
+@pytest.fixture(scope='module')
+def puma():
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        return load_robot('puma560')
+
+
+def holding_effort(model, push):
+    """Drive torques that hold the arm at Q while pushed (the oracle)."""
+    z = np.zeros(6)
+    # tau = g + J^T F_e with F_e = -F_ext: what the drives must apply
+    return ref.inverse_dynamics(model, Q, z, z, -push, 'base')
+
+
+def send(g, seq, effort, with_effort=True):
+    stamp = g['probe'].keyed_stamp(seq)
+    msg = joint_state(NAMES, Q, np.zeros(6), stamp)
+    if with_effort:
+        msg.effort = [float(x) for x in effort]
+    g['js'].publish(msg)
+    g['probe'].spin_for(0.01)           # about 100 Hz
+    return stamp
+
+
+def observer_status(g):
+    count = len(g['diag'])
+    assert g['probe'].spin_until(lambda: len(g['diag']) > count, 5.0)
+    status = next(s for s in g['diag'][-1].status
+                  if s.name.endswith(': observer'))
+    return status, {kv.key: kv.value for kv in status.values}
+
+
+def test_observer_topics_and_a_contact_mid_run(graph, puma):
+    g = graph
+    free, pushed = holding_effort(puma, np.zeros(6)), \
+        holding_effort(puma, PUSH)
+    stamps = []
+    for k in range(80):                         # free: no contact
+        stamps.append(send(g, k + 1, free))
+    first_contact_index = len(stamps)
+    for k in range(80):                         # pushed from here on
+        stamps.append(send(g, 1000 + k, pushed))
+    probe = g['probe']
+    keys = [(s.sec, s.nanosec) for s in stamps]
+
+    def answered(box):
+        return {(m.header.stamp.sec, m.header.stamp.nanosec): m
+                for m in box}
+
+    # the last JointState is answered on both topics (a loaded machine
+    # may drop a few inputs from the node's queue: not all are required)
+    assert probe.spin_until(
+        lambda: keys[-1] in answered(g['ext']) and
+        keys[-1] in answered(g['wrench']), 10.0), g['node'].log()
+    ext, wr = answered(g['ext']), answered(g['wrench'])
+    # one of each per JointState, with its stamp, and nothing else
+    assert set(ext) <= set(keys) and set(wr) <= set(keys)
+    assert len(g['ext']) == len(ext) and len(g['wrench']) == len(wr)
+    assert set(ext) == set(wr)
+    assert len(ext) >= 0.5 * len(keys)
+    last = ext[keys[-1]]
+    assert list(last.name) == list(puma.joint_names)
+    for m in g['ext']:
+        assert np.isfinite(m.effort).all()
+    for m in g['wrench']:
+        f, t = m.wrench.force, m.wrench.torque
+        assert np.isfinite([f.x, f.y, f.z, t.x, t.y, t.z]).all()
+        assert m.header.frame_id == 'base_link'
+    # free: a small residual; pushed: J^T F_ext, and the push itself
+    free_keys = [k for k in keys[:first_contact_index] if k in ext]
+    quiet = np.array(ext[free_keys[-1]].effort)
+    assert np.abs(quiet).max() < 0.5
+    r = np.array(last.effort)
+    J = ref.ee_jacobian(puma, Q)
+    np.testing.assert_allclose(r, J.T @ PUSH, atol=0.05 * np.abs(
+        J.T @ PUSH).max())
+    w = wr[keys[-1]].wrench
+    F = np.array([w.force.x, w.force.y, w.force.z,
+                  w.torque.x, w.torque.y, w.torque.z])
+    assert np.linalg.norm(F[:3] - PUSH[:3]) <= \
+        0.1 * np.linalg.norm(PUSH[:3]) + 1.0, F
+    assert np.linalg.norm(F[3:] - PUSH[3:]) <= 0.2, F
+    # contact: false first (steady repeats), then true once it started
+    assert probe.spin_until(lambda: g['contact'] and g['contact'][-1].data,
+                            3.0)
+    values = [m.data for m in g['contact']]
+    assert values[0] is False and True in values
+    assert values.index(True) > 0
+    status, kv = observer_status(g)
+    assert kv['in_contact'] == 'true' and kv['contacts'] == '1', kv
+    assert kv['state'] == 'running'
+    # torques went on all along
+    assert len(g['torques']) >= len(stamps) - 1
+
+
+def test_without_effort_the_observer_says_so_and_torques_go_on(graph, puma):
+    g = graph
+    before = len(g['torques'])
+    for k in range(5):
+        send(g, 5000 + k, None, with_effort=False)
+    assert g['probe'].spin_until(lambda: len(g['torques']) >= before + 5,
+                                 5.0)
+    status, kv = observer_status(g)
+    assert kv['state'].startswith('cannot run'), kv
+    log = g['node'].log()
+    assert log.count('carry no effort') == 1, log
+
+
+def test_the_payload_is_not_external(graph, puma):
+    """A payload declared at run time leaves the residual, not a contact."""
+    from rcl_interfaces.srv import SetParameters
+    from rclpy.parameter import Parameter
+    g = graph
+    mass = 3.0
+    result = g['probe'].call(SetParameters, f'{NODE}/set_parameters',
+                             SetParameters.Request(parameters=[
+                                 Parameter('payload.mass', value=mass)
+                                 .to_parameter_msg()])).results[0]
+    assert result.successful, result.reason
+    # the drives now also hold a 3 kg point mass at the tool origin: its
+    # weight is a force the environment applies there (oracle's gravity)
+    weight = np.zeros(6)
+    weight[:3] = mass * np.asarray(puma.gravity)
+    effort = holding_effort(puma, weight)
+    stamps = [send(g, 7000 + k, effort) for k in range(60)]
+    key = (stamps[-1].sec, stamps[-1].nanosec)
+    probe = g['probe']
+
+    def last():
+        return next((m for m in g['ext'] if (m.header.stamp.sec,
+                                             m.header.stamp.nanosec) == key),
+                    None)
+    assert probe.spin_until(lambda: last() is not None, 10.0)
+    assert np.abs(last().effort).max() < 0.3, last().effort
+    assert probe.spin_until(lambda: not g['contact'][-1].data, 3.0)
+
+
+@pytest.mark.parametrize('args, message', [
+    (['-p', 'observer.thresholds:=[1.0, 2.0]'],
+     'observer.thresholds: must have 1 or 6 values'),
+    (['-p', 'observer.hysteresis:=1.5'], 'observer.hysteresis: must be <= 1'),
+    (['-p', 'observer.gain:=0.0'], 'observer.gain: must be > 0'),
+])
+def test_bad_observer_settings_refuse_to_start(args, message):
+    cmd = id_node_cmd('puma560.yaml', '-p', 'observer.enabled:=true', *args)
+    proc = subprocess.run(cmd, env=ros_env(domain_id(71)),
+                          capture_output=True, text=True, timeout=90)
+    assert proc.returncode == 2, proc.stderr
+    assert message in proc.stderr, proc.stderr
+    assert 'Traceback' not in proc.stderr
