@@ -318,11 +318,14 @@ def drive_terms(model):
     with ``torques(qd, qdd)`` and ``armature``; the friction and offset
     are what the drives lose (``drive_torque``, called with qdd None) and
     the rotor inertia goes into the momentum.  ``(None, None)`` when the
-    model has none.
+    model has none, or only zeros (every URDF model carries a record).
     """
     info = getattr(model, 'info', None) or {}
     drives = info.get('drives') if isinstance(info, dict) else None
     if drives is None or not callable(getattr(drives, 'torques', None)):
+        return None, None
+    is_zero = getattr(drives, 'is_zero', None)
+    if callable(is_zero) and is_zero():     # a URDF without drive terms
         return None, None
     zero = np.zeros(model.n)
 
