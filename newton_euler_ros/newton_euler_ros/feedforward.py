@@ -36,16 +36,12 @@ import numpy as np
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
                    inverse_dynamics, mass_matrix)
 from .core.effects import EffectDynamics
+from .core.inertia import format_moments, inertia_matrix, principal_moments
 from .core.model import with_payload
+from .core.text import clip
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
-
-
-def clip(text, limit=300):
-    """Return text cut to ``limit`` characters (for logs and messages)."""
-    text = str(text)
-    return text if len(text) <= limit else text[:limit] + '...'
 
 
 class InputRejected(Exception):
@@ -299,13 +295,11 @@ def check_payload(mass, com, inertia6):
     if values.shape != (6,) or not np.isfinite(values).all():
         raise ValueError(f'payload.inertia: must be 6 finite numbers, got '
                          f'{values.tolist()}')
-    ixx, iyy, izz, ixy, iyz, ixz = values
-    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-    eig = np.linalg.eigvalsh(inertia)
-    if eig[0] < -1e-12 * max(abs(eig).max(), 1e-300):
+    inertia = inertia_matrix(*values)
+    eig, valid = principal_moments(inertia)
+    if not valid:
         raise ValueError(f'payload.inertia: not positive semi-definite '
-                         f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
-                         f'{eig[2]:.6g})')
+                         f'(principal moments {format_moments(eig)})')
     return mass, com, inertia
 
 

@@ -210,6 +210,22 @@ def _flags(gravity, velocity_products, mode):
             | (mode << K.WRENCH_SHIFT))
 
 
+def first_singular_pivot(D, rtol=1e-12):
+    """
+    Return the first joint where D is not positive definite, or None.
+
+    The Cholesky factorisation of the kernels on D - rtol max|diag D| 1:
+    a pivot that is not clearly positive (relative to D's scale) counts.
+    """
+    D = np.asarray(D, dtype=np.float64)
+    n = D.shape[0]
+    scale = max(float(np.abs(np.diag(D)).max()), 1e-300) if n else 1.0
+    shifted = D - rtol * scale * np.eye(n)
+    bad = K.cholesky_solve(shifted, np.zeros(n), np.zeros((n, n)),
+                           np.empty(n))
+    return None if bad < 0 else int(bad)
+
+
 def _not_positive_definite(model, q, j, ws):
     """
     Return the NotPositiveDefiniteError for a singular D (first joint).

@@ -47,14 +47,18 @@ the attribute.
 """
 import math
 import os
+import warnings
 import xml.etree.ElementTree as ET  # noqa: N817 (only for ParseError)
 
 import defusedxml
 import defusedxml.ElementTree as DET
 import numpy as np
 
-from .errors import RobotFileError
-from .model import make_chain, PRISMATIC, REVOLUTE, rpy_matrix
+from .errors import RobotFileError, RobotFileWarning
+from .inertia import (format_moments, merge_bodies, principal_moments,
+                      triangle_note)
+from .model import make_chain, pose_matrix, PRISMATIC, REVOLUTE, rpy_matrix
+from .text import clip, read_text
 
 MAX_BYTES = 16 * 1024 * 1024
 MAX_ELEMENTS = 20000
@@ -66,8 +70,7 @@ JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'fixed', 'floating',
 
 
 def _short(text, limit=MAX_NAME):
-    text = str(text)
-    return text if len(text) <= limit else text[:limit] + '...'
+    return clip(text, limit)
 
 
 class _Source:
@@ -96,7 +99,6 @@ def read_urdf_text(text_or_path, label=None):
                 f'{label}: {len(text)} characters, more than the '
                 f'{MAX_BYTES} accepted')
         return text, label
-    from .robot_file import read_text
     return read_text(text, MAX_BYTES, 'URDF file'), label or \
         os.path.basename(text)
 
@@ -179,13 +181,6 @@ def _origin_ops(xyz, rpy):
     return ops
 
 
-def _transform(xyz, rpy):
-    T = np.eye(4)
-    T[:3, :3] = rpy_matrix(*rpy)
-    T[:3, 3] = xyz
-    return T
-
-
 def _axis_motion(kind, axis, q):
     """4x4 of a joint's own motion by q (a locked off-chain joint)."""
     T = np.eye(4)
@@ -226,7 +221,7 @@ class _Joint:
 
     @property
     def origin(self):
-        return _transform(self.xyz, self.rpy)
+        return pose_matrix(self.xyz, self.rpy)
 
 
 def _name(el, what, src, index):
@@ -262,12 +257,10 @@ def _read_inertial(link, el, src):
     inertia = np.array([[vals['ixx'], vals['ixy'], vals['ixz']],
                         [vals['ixy'], vals['iyy'], vals['iyz']],
                         [vals['ixz'], vals['iyz'], vals['izz']]])
-    eig = np.linalg.eigvalsh(inertia)
-    scale = max(abs(eig).max(), 1e-300)
-    if eig[0] < -1e-9 * scale:
+    eig, valid = principal_moments(inertia)
+    if not valid:
         raise src.error(f'{where}<inertia>', 'not positive semi-definite '
-                        f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
-                        f'{eig[2]:.6g})')
+                        f'(principal moments {format_moments(eig)})')
     R = rpy_matrix(*rpy)
     link.mass = mass
     link.com = np.array(xyz)
@@ -439,21 +432,9 @@ def _lumped(links, joints, start, stop_joints, pose=np.eye(4)):
 
 def _combine(parts, links):
     """Mass, centre of mass and inertia (about it) of rigidly joined links."""
-    mass = 0.0
-    first = np.zeros(3)
-    for lname, T, _ in parts:
-        lk = links[lname]
-        mass += lk.mass
-        first += lk.mass * (T[:3, :3] @ lk.com + T[:3, 3])
-    com = first / mass if mass > 0.0 else np.zeros(3)
-    inertia = np.zeros((3, 3))
-    for lname, T, _ in parts:
-        lk = links[lname]
-        R = T[:3, :3]
-        c = R @ lk.com + T[:3, 3] - com
-        inertia += R @ lk.inertia @ R.T + lk.mass * (
-            (c @ c) * np.eye(3) - np.outer(c, c))
-    return mass, com, 0.5 * (inertia + inertia.T)
+    return merge_bodies([(links[lname].mass, links[lname].com,
+                          links[lname].inertia, T[:3, :3], T[:3, 3])
+                         for lname, T, _ in parts])
 
 
 def urdf_model(text, label='robot_description', base=None, tip=None,
@@ -465,7 +446,6 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     """
-    from .robot_file import triangle_note
     name, root, links, joints = parse_urdf(text, label)
     found = []
     base = root if base is None else base
@@ -613,8 +593,6 @@ def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):
     :class:`~newton_euler_ros.core.robot_file.RobotFileWarning`; errors
     raise :class:`~newton_euler_ros.core.errors.RobotFileError`.
     """
-    import warnings
-    from .robot_file import RobotFileWarning
     model, found, _ = inspect_urdf(text_or_path, base=base, tip=tip,
                                    gravity=gravity)
     for message in found:
