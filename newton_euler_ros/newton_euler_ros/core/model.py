@@ -65,7 +65,7 @@ import math
 
 import numpy as np
 
-from . import _kernels as K
+from . import kernels as K
 from .inertia import inertia_matrix, merge_bodies  # noqa: F401 (re-export)
 from .workspace import Workspace
 

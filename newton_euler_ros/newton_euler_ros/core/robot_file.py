@@ -31,7 +31,8 @@ import warnings
 import numpy as np
 import yaml
 
-from .dynamics import first_singular_pivot, mass_matrix
+from .calling import first_singular_pivot
+from .dynamics import mass_matrix
 from .errors import DynamicsInputError, RobotFileError, RobotFileWarning
 from .inertia import (format_moments, inertia_matrix, is_symmetric, Note,
                       principal_moments, triangle_note)
