@@ -105,6 +105,17 @@ def workspace(model, ws):
     return ws
 
 
+def foreign_workspace(model, ws):
+    """
+    Raise the one-line error for a ``ws`` that is not a Workspace at all.
+
+    Called where a fast path met an AttributeError: for any other ``ws``
+    it returns, and the caller re-raises the AttributeError (a bug).
+    """
+    if ws is not None and type(ws) is not Workspace:
+        workspace(model, ws)
+
+
 def vector(name, x, size):
     """Return x as a contiguous float64 vector of the given size, or raise."""
     if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1

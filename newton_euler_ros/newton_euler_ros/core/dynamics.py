@@ -76,12 +76,11 @@ from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
                     gravity_torques_batch, inverse_dynamics_batch,
                     mass_matrix_batch)
 from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
-                      first_singular_pivot, FORWARD_DYNAMICS_METHODS, INT,
+                      first_singular_pivot, foreign_workspace, FORWARD_DYNAMICS_METHODS, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
                       out_array, PACKED, Refused, status_error, strict_entry,
                       VEC, vector, workspace, WRENCH_FRAMES, wrench_mode)
 from .errors import DynamicsInputError
-from .workspace import Workspace
 
 __all__ = [
     'CORIOLIS_METHODS', 'FORWARD_DYNAMICS_METHODS', 'MASS_MATRIX_METHODS',
@@ -109,12 +108,7 @@ _aba = strict_entry(K.run_forward_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
 _jac = strict_entry(K.run_jacobian, PACKED, VEC, BOOL, MAT, MAT, MAT)
 _poses = strict_entry(K.run_link_poses, PACKED, VEC, MAT, MAT)
 
-_W = Workspace                  # for the fast paths' one type check
 assert (K.GRAVITY, K.VELOCITY, K.WRENCH_SHIFT) == (1, 2, 2)  # literals below
-
-
-def _bad_workspace(model, ws):
-    workspace(model, ws)        # raises: ws is not a Workspace
 
 
 # ---------------------------------------------------------------------------
@@ -152,18 +146,13 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
         N m for revolute and N for prismatic joints.
 
     """
-    if ws is None:
-        w = model.default_workspace
-    elif type(ws) is _W:
-        w = ws
-    else:
-        w = _bad_workspace(model, ws)
+    w = model.default_workspace if ws is None else ws
     flags = 3 if gravity is True and velocity_products is True else (
         (1 if gravity else 0) | (2 if velocity_products else 0))
     if wrench is not None:
         flags |= wrench_mode(wrench, wrench_frame) << 2
-    tau = np.empty(w.n) if out is None else out
     try:
+        tau = np.empty(w.n) if out is None else out
         if _tau(model.packed, q, w.zeros if qd is None else qd,
                 w.zeros if qdd is None else qdd,
                 w.zero_wrench if wrench is None else wrench, flags, w.ws,
@@ -171,6 +160,9 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
             return tau
     except Refused:
         pass
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
     return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
 
 
@@ -191,18 +183,16 @@ def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
 
 def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
-    if ws is None:
-        w = model.default_workspace
-    elif type(ws) is _W:
-        w = ws
-    else:
-        w = _bad_workspace(model, ws)
-    tau = np.empty(w.n) if out is None else out
+    w = model.default_workspace if ws is None else ws
     try:
+        tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
     except Refused:
         pass
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
     return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
 
 
@@ -225,18 +215,16 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
     times them).  Any other ``method`` raises ValueError.
     """
     if method == 'crba':
-        if ws is None:
-            w = model.default_workspace
-        elif type(ws) is _W:
-            w = ws
-        else:
-            w = _bad_workspace(model, ws)
-        D = np.empty((w.n, w.n)) if out is None else out
+        w = model.default_workspace if ws is None else ws
         try:
+            D = np.empty((w.n, w.n)) if out is None else out
             if _crba(model.packed, q, w.ws, D) < 0:
                 return D
         except Refused:
             pass
+        except AttributeError:
+            foreign_workspace(model, ws)
+            raise
     elif method != 'newton_euler':
         raise bad_method(method)
     ws = workspace(model, ws)
@@ -283,19 +271,17 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
         composite = False
     else:
         raise bad_method(method, CORIOLIS_METHODS)
-    if ws is None:
-        w = model.default_workspace
-    elif type(ws) is _W:
-        w = ws
-    else:
-        w = _bad_workspace(model, ws)
-    C = np.empty((w.n, w.n)) if out is None else out
+    w = model.default_workspace if ws is None else ws
     try:
+        C = np.empty((w.n, w.n)) if out is None else out
         if _coriolis(model.packed, q, qd, composite, w.ws, w.cw, w.scratch,
                      C) < 0:
             return C
     except Refused:
         pass
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
     ws = workspace(model, ws)
     n = ws.n
     q, qd = vector('q', q, n), vector('qd', qd, n)
@@ -395,20 +381,18 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
     if wrench is not None:
         flags |= wrench_mode(wrench, wrench_frame) << 2
     if method == 'aba':
-        if ws is None:
-            w = model.default_workspace
-        elif type(ws) is _W:
-            w = ws
-        else:
-            w = _bad_workspace(model, ws)
-        qdd = np.empty(w.n) if out is None else out
+        w = model.default_workspace if ws is None else ws
         try:
+            qdd = np.empty(w.n) if out is None else out
             if _aba(model.packed, q, qd, tau,
                     w.zero_wrench if wrench is None else wrench, flags,
                     w.ws, w.aw, qdd) < 0:
                 return qdd
         except Refused:
             pass
+        except AttributeError:
+            foreign_workspace(model, ws)
+            raise
         return _aba_converted(model, ws, q, qd, tau, wrench, flags, out)
     if method != 'cholesky':
         raise bad_method(method, FORWARD_DYNAMICS_METHODS)

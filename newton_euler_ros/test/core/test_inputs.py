@@ -169,3 +169,17 @@ def test_a_refused_call_leaves_the_fast_path_intact(arm):
     inverse_dynamics(arm, [0.3, -0.4])
     assert len(dynamics._tau.overloads) == 1    # no second compilation
     assert np.array_equal(inverse_dynamics(arm, q), first)
+
+
+@pytest.mark.parametrize('call', [
+    lambda m, ws: inverse_dynamics(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: gravity_torques(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: mass_matrix(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: coriolis_matrix(m, [0.0, 0.0], [0.0, 0.0], ws=ws),
+    lambda m, ws: forward_dynamics(m, [0.0, 0.0], [0.0, 0.0], [0.0, 0.0],
+                                   ws=ws),
+])
+def test_a_ws_that_is_no_workspace_is_one_clear_error(arm, call):
+    with pytest.raises(DynamicsInputError, match='ws must be a float64 '
+                                                 'Workspace'):
+        call(arm, np.zeros((2, 21)))
