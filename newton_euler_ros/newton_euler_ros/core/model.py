@@ -305,7 +305,7 @@ class RobotModel:
     info : dict of source details (e.g. URDF link names); not dynamics
     links_array, frames_array : read-only copies for the kernels
     packed : both in one read-only array, as the kernels' entry points
-        take them (``_kernels.pack``)
+        take them (``kernels.pack``)
 
     """
 
