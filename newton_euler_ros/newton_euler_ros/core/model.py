@@ -17,7 +17,7 @@ The constant robot model: a serial chain of revolute and prismatic joints.
 
 A :class:`RobotModel` is immutable after construction (its arrays are
 read-only).  Per-call scratch memory lives in a separate
-:class:`~newton_euler_ros.core.dynamics.Workspace`.
+:class:`~newton_euler_ros.core.workspace.Workspace`.
 
 One joint model for every source.  Joint j carries link frame j-1 to link
 frame j as
