@@ -92,7 +92,7 @@ def aba_inertias(links, frames, tau, ws, aw):
     """
     ABA pass 2, tip to base: articulated inertias and bias forces.
 
-    Returns -1, or the index of the joint whose D = S^T IA S is not
+    Returns -1, or the index of the joint whose d = S^T IA S is not
     positive (no inertia moves with it: the mass matrix is singular).
     """
     n = links.shape[0]
@@ -101,26 +101,26 @@ def aba_inertias(links, frames, tau, ws, aw):
         U = (aw[j, A_IA + k], aw[j, A_IA + 6 + k], aw[j, A_IA + 12 + k],
              aw[j, A_IA + 18 + k], aw[j, A_IA + 24 + k],
              aw[j, A_IA + 30 + k])
-        D = U[k]
-        if not D > 0:       # an int literal: exact in any dtype
+        d = U[k]
+        if not d > 0:       # an int literal: exact in any dtype
             return j
         u = tau[j] - aw[j, A_PA + k]
         for r in range(6):
             aw[j, A_U + r] = U[r]
-        aw[j, A_D] = D
+        aw[j, A_D] = d
         aw[j, A_UU] = u
         if j == 0:
             break
-        # Ia = IA - U U^T / D and pa = pA + Ia c + U u / D, in place
+        # Ia = IA - U U^T / d and pa = pA + Ia c + U u / d, in place
         for r in range(6):
-            Ur = U[r] / D
+            Ur = U[r] / d
             for s in range(6):
                 aw[j, A_IA + 6 * r + s] -= Ur * U[s]
         c = vec6(aw, j, A_C)
         mat6_vec(aw, j, A_IA, c, aw, n, 0)
-        uD = u / D
+        ud = u / d
         for r in range(6):
-            aw[j, A_PA + r] += aw[n, r] + U[r] * uD
+            aw[j, A_PA + r] += aw[n, r] + U[r] * ud
         # carry both into frame j-1 about O_{j-1}: X_F = [[R, [p] R], [0, R]]
         R, p = stored_placement(ws, j)
         Rt = transpose(R)

@@ -33,23 +33,23 @@ def mass_matrix_crba(links, frames, q, ws, D):
     entries j > i of the column come from symmetry, D[j, i] = D[i, j],
     filled when column j is done.
 
-    Composite i is kept in kernel frame i as its mass M, first moment
+    Composite i is kept in kernel frame i as its mass Mc, first moment
     h = sum m_k c_k (c_k: centre of mass of link k seen from O_i) and
     rotational inertia I about O_i, never divided by the mass, so massless
     links and composites need no care.  It is built from the tip: add link
     i (h += m c, I += I_c + m (|c|^2 1 - c c^T), with the symmetric part of
     I_c), use it, then carry it into frame i-1 (R, p of frame i in frame
-    i-1): with hr = R h, h' = hr + M p and, since the position of each
+    i-1): with hr = R h, h' = hr + Mc p and, since the position of each
     mass element becomes r' = R r + p,
-    I' = R I R^T - [p][hr] - [hr][p] - M [p][p] ([x] the cross-product
-    matrix), written with g = hr + M p / 2 as
-    I' = R I R^T + 2 (g . p) 1 - (g p^T + p g^T) so it stays symmetric.
+    I' = R I R^T - [p][hr] - [hr][p] - Mc [p][p] ([x] the cross-product
+    matrix), written with gp = hr + Mc p / 2 as
+    I' = R I R^T + 2 (gp . p) 1 - (gp p^T + p gp^T) so it stays symmetric.
 
     Unit rate of joint i (axis z through O_i): revolute, angular
     acceleration z with O_i at rest; prismatic, no rotation and O_i
     accelerating by z.  Newton-Euler about O_i (not the centre of mass)
-    at zero velocity: F = M a + al x h, N = I al + h x a, that is
-    F = z x h, N = I z (revolute) or F = M z, N = h x z (prismatic).
+    at zero velocity: F = Mc a + al x h, N = I al + h x a, that is
+    F = z x h, N = I z (revolute) or F = Mc z, N = h x z (prismatic).
     D[i, i] is joint i's component (N_z, or F_z); for j = i-1..0 the
     wrench is carried to frame j by the recursion's backward step
     F <- R F, N <- R N + p x F and D[j, i] = D[i, j] is joint j's
@@ -66,7 +66,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
     joint_trig(links, frames, q, ws)
     for j in range(n):
         R, p = placement(links, frames, j, ws)
-    M = zero
+    Mc = zero
     h = (zero, zero, zero)
     Io = (zero, zero, zero, zero, zero, zero)
     for i in range(n - 1, -1, -1):
@@ -79,7 +79,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
         mc1 = m * c1
         mc2 = m * c2
         k = L_INERTIA
-        M = M + m
+        Mc = Mc + m
         h = (h[0] + mc0, h[1] + mc1, h[2] + mc2)
         Io = (Io[0] + links[i, k] + (mc1 * c1 + mc2 * c2),
               Io[1] + links[i, k + 4] + (mc0 * c0 + mc2 * c2),
@@ -94,7 +94,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
             N = (Io[5], Io[4], Io[2])
             D[i, i] = N[2]
         else:
-            F = (zero, zero, M)
+            F = (zero, zero, Mc)
             N = (h[1], -h[0], zero)
             D[i, i] = F[2]
         # ---- carry it to the base, joint by joint ----
@@ -112,16 +112,16 @@ def mass_matrix_crba(links, frames, q, ws, D):
             R, p = stored_placement(ws, i)
             hr = rot(R, h[0], h[1], h[2])
             Ir = sym_rotate(R, Io)
-            hM = half * M
-            g = (hr[0] + hM * p[0], hr[1] + hM * p[1], hr[2] + hM * p[2])
-            g0p0 = g[0] * p[0]
-            g1p1 = g[1] * p[1]
-            g2p2 = g[2] * p[2]
-            Io = (Ir[0] + ((g1p1 + g2p2) + (g1p1 + g2p2)),
-                  Ir[1] + ((g0p0 + g2p2) + (g0p0 + g2p2)),
-                  Ir[2] + ((g0p0 + g1p1) + (g0p0 + g1p1)),
-                  Ir[3] - (g[0] * p[1] + g[1] * p[0]),
-                  Ir[4] - (g[1] * p[2] + g[2] * p[1]),
-                  Ir[5] - (g[0] * p[2] + g[2] * p[0]))
-            h = (hr[0] + M * p[0], hr[1] + M * p[1], hr[2] + M * p[2])
+            hMc = half * Mc
+            gp = (hr[0] + hMc * p[0], hr[1] + hMc * p[1], hr[2] + hMc * p[2])
+            gp0 = gp[0] * p[0]
+            gp1 = gp[1] * p[1]
+            gp2 = gp[2] * p[2]
+            Io = (Ir[0] + ((gp1 + gp2) + (gp1 + gp2)),
+                  Ir[1] + ((gp0 + gp2) + (gp0 + gp2)),
+                  Ir[2] + ((gp0 + gp1) + (gp0 + gp1)),
+                  Ir[3] - (gp[0] * p[1] + gp[1] * p[0]),
+                  Ir[4] - (gp[1] * p[2] + gp[2] * p[1]),
+                  Ir[5] - (gp[0] * p[2] + gp[2] * p[0]))
+            h = (hr[0] + Mc * p[0], hr[1] + Mc * p[1], hr[2] + Mc * p[2])
     return matrix_status(D)

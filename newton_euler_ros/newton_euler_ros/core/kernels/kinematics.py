@@ -126,9 +126,9 @@ def link_inertia(links, j):
 
 
 @njit(cache=True, inline='always')
-def body_inertia(links, j, R, o, M, row, col):
+def body_inertia(links, j, R, o, out, row, col):
     """
-    Write link j's spatial inertia into ``M[row, col:col + 36]``.
+    Write link j's spatial inertia into ``out[row, col:col + 36]``.
 
     About the origin o of the frame whose rotation (to link j's kernel
     frame axes) is R: the link's centre of mass is o + R c and its
@@ -146,14 +146,14 @@ def body_inertia(links, j, R, o, M, row, col):
             v = Ic[3 * r + s] - mc[r] * c[s]
             if r == s:
                 v = v + cc
-            M[row, col + 6 * r + s] = v
-            M[row, col + 6 * (r + 3) + s + 3] = m if r == s else zero
+            out[row, col + 6 * r + s] = v
+            out[row, col + 6 * (r + 3) + s + 3] = m if r == s else zero
     # m [c] (top right) and its transpose (bottom left)
     X = (zero, -mc[2], mc[1], mc[2], zero, -mc[0], -mc[1], mc[0], zero)
     for r in range(3):
         for s in range(3):
-            M[row, col + 6 * r + s + 3] = X[3 * r + s]
-            M[row, col + 6 * (s + 3) + r] = X[3 * r + s]
+            out[row, col + 6 * r + s + 3] = X[3 * r + s]
+            out[row, col + 6 * (s + 3) + r] = X[3 * r + s]
 
 
 @njit(cache=True)

@@ -51,19 +51,19 @@ def check_finite(q, qd, qdd, wrench):
 
 
 @njit(cache=True)
-def matrix_status(M):
+def matrix_status(X):
     """Return -1 when every entry is finite, else OVERFLOW."""
-    for i in range(M.shape[0]):
-        if first_nonfinite(M[i]) >= 0:
+    for i in range(X.shape[0]):
+        if first_nonfinite(X[i]) >= 0:
             return OVERFLOW
     return -1
 
 
 @njit(cache=True, inline='always')
-def first_bad_row(M, status):
-    """Index of the first row of M with a non-finite entry (status set)."""
-    for k in range(M.shape[0]):
-        if first_nonfinite(M[k]) >= 0:
+def first_bad_row(X, status):
+    """Index of the first row of X with a non-finite entry (status set)."""
+    for k in range(X.shape[0]):
+        if first_nonfinite(X[k]) >= 0:
             status[0] = OVERFLOW
             return k
     return -1
