@@ -32,6 +32,8 @@ The one entry path of every dynamics function is
 So a float64 array costs no Python check at all, and a list costs one
 conversion more.
 """
+import math
+
 from numba import njit, types
 import numpy as np
 
@@ -197,12 +199,14 @@ def bad_method(method, methods=MASS_MATRIX_METHODS):
 # status codes, decoded once
 
 def status_error(code, values=(), names=INPUTS, precision='float64',
-                 model=None, q=None, ws=None, row=None):
+                 model=None, q=None, ws=None, row=None, given=None):
     """
     Return the exception a kernel's status code (>= 0) stands for.
 
     ``values``: the inputs as the kernel saw them (for the non-finite
-    entry's value); ``model``, ``q`` and ``ws`` name the joint of a
+    entry's value); ``given``: the inputs as the caller gave them, when
+    the kernel saw them rounded (float32: a finite input beyond its
+    range became inf); ``model``, ``q`` and ``ws`` name the joint of a
     singular mass matrix; ``row`` the row of a batch.
     """
     at = '' if row is None else f' for row {row}'
@@ -221,6 +225,13 @@ def status_error(code, values=(), names=INPUTS, precision='float64',
         return DynamicsInputError(
             'ws does not fit this model (made for another number of joints)')
     arg, i = divmod(code, K.NONFINITE)
+    if given is not None and given[arg] is not None:
+        value = float(np.ravel(np.asarray(given[arg], dtype=np.float64))[i])
+        if math.isfinite(value):
+            limit = float(np.finfo(precision).max)
+            return DynamicsInputError(
+                f'{names[arg]}[{i}] is {value!r}, outside the {precision} '
+                f'range (|x| <= {limit:.8g})')
     return DynamicsInputError(
         f'{names[arg]}[{i}] is {float(values[arg][i])!r}; every entry must '
         f'be finite')

@@ -54,7 +54,6 @@ Examples
 dtype('float32')
 
 """
-import math
 
 import numpy as np
 
@@ -89,16 +88,7 @@ def _out(out):
 
 def _raise(code, rounded, given, names=_INPUTS):
     """Raise for a bad input, naming float32 overflow as such."""
-    if code != K.OVERFLOW:
-        arg, i = divmod(code, 1000)
-        if given[arg] is not None:
-            value = float(np.ravel(np.asarray(given[arg],
-                                              dtype=np.float64))[i])
-            if math.isfinite(value):
-                raise DynamicsInputError(
-                    f'{names[arg]}[{i}] is {value!r}, outside the '
-                    f'float32 range (|x| <= {_F32_MAX:.8g})')
-    raise status_error(code, rounded, names, 'float32')
+    raise status_error(code, rounded, names, 'float32', given=given)
 
 
 class Float32Dynamics:
