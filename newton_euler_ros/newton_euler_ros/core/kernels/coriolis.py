@@ -23,7 +23,7 @@ from ._jit import njit
 from .kinematics import body_inertia, joint_trig, link_geometry, revolute
 from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_OW,
                      CW_RW, CW_S, CW_SD, CW_V, F_CONST)
-from .spatial import cross, mat6_vec, matmul, rot, skew, vec6
+from .spatial import cross, load3, load9, mat6_vec, matmul, rot, skew, vec6
 from .status import matrix_status
 
 
@@ -92,10 +92,8 @@ def coriolis_backward(links, frames, cw):
     for k in range(72):
         cw[n, k] = zero
     for j in range(n - 1, -1, -1):
-        Rw = (cw[j, CW_RW], cw[j, CW_RW + 1], cw[j, CW_RW + 2],
-              cw[j, CW_RW + 3], cw[j, CW_RW + 4], cw[j, CW_RW + 5],
-              cw[j, CW_RW + 6], cw[j, CW_RW + 7], cw[j, CW_RW + 8])
-        ow = (cw[j, CW_OW], cw[j, CW_OW + 1], cw[j, CW_OW + 2])
+        Rw = load9(cw, j, CW_RW)
+        ow = load3(cw, j, CW_OW)
         body_inertia(links, j, Rw, ow, cw, j, CW_I)
         V = vec6(cw, j, CW_V)
         mat6_vec(cw, j, CW_I, V, cw, n, H)

@@ -28,7 +28,8 @@ from ._jit import njit
 from .layout import (C_ONE, C_ZERO, F_BASE, F_CONST, F_TOOL, L_BODY, L_COM,
                      L_INERTIA, L_MASS, L_P, L_R, L_TYPE, W_CT, W_DD, W_P, W_R,
                      W_ST)
-from .spatial import cross, frame_rot, matmul, rot, rot_t, transpose
+from .spatial import (cross, frame_rot, load3, load9, matmul, rot, rot_t,
+                      transpose)
 
 
 @njit(cache=True)
@@ -110,19 +111,13 @@ def placement(links, frames, j, ws):
 @njit(cache=True, inline='always')
 def stored_placement(ws, j):
     """Return R, p of kernel frame j in j-1 as a pass stored them in ws."""
-    R = (ws[j, W_R], ws[j, W_R + 1], ws[j, W_R + 2],
-         ws[j, W_R + 3], ws[j, W_R + 4], ws[j, W_R + 5],
-         ws[j, W_R + 6], ws[j, W_R + 7], ws[j, W_R + 8])
-    return R, (ws[j, W_P], ws[j, W_P + 1], ws[j, W_P + 2])
+    return load9(ws, j, W_R), load3(ws, j, W_P)
 
 
 @njit(cache=True, inline='always')
 def link_inertia(links, j):
     """Return link j's rotational inertia about its com, row-major 3x3."""
-    k = L_INERTIA
-    return (links[j, k], links[j, k + 1], links[j, k + 2],
-            links[j, k + 3], links[j, k + 4], links[j, k + 5],
-            links[j, k + 6], links[j, k + 7], links[j, k + 8])
+    return load9(links, j, L_INERTIA)
 
 
 @njit(cache=True, inline='always')
@@ -185,11 +180,9 @@ def chain_poses(links, frames, q, ws, Ts, link_frames):
         Ro = Rw
         po = pw
         if link_frames and j < n:
-            k = L_BODY
-            RB = (links[j, k], links[j, k + 1], links[j, k + 2],
-                  links[j, k + 3], links[j, k + 4], links[j, k + 5],
-                  links[j, k + 6], links[j, k + 7], links[j, k + 8])
-            t = rot(Rw, links[j, k + 9], links[j, k + 10], links[j, k + 11])
+            RB = load9(links, j, L_BODY)
+            t = rot(Rw, links[j, L_BODY + 9], links[j, L_BODY + 10],
+                    links[j, L_BODY + 11])
             po = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
             Ro = matmul(Rw, RB)
         for k in range(9):
@@ -234,9 +227,7 @@ def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
             lin = z
             ang = (zero, zero, zero)
         if in_ee_axes:
-            Re = (Ts[n + 1, 0], Ts[n + 1, 1], Ts[n + 1, 2], Ts[n + 1, 3],
-                  Ts[n + 1, 4], Ts[n + 1, 5], Ts[n + 1, 6], Ts[n + 1, 7],
-                  Ts[n + 1, 8])
+            Re = load9(Ts, n + 1, 0)
             lin = rot_t(Re, lin[0], lin[1], lin[2])
             ang = rot_t(Re, ang[0], ang[1], ang[2])
         for k in range(3):

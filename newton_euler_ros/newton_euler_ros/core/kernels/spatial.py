@@ -75,10 +75,24 @@ def skew(p):
     return (zero, -p[2], p[1], p[2], zero, -p[0], -p[1], p[0], zero)
 
 
+@njit(cache=True, inline='always')
+def load3(a, row, col):
+    """Return the 3-vector stored in ``a[row, col:col + 3]``."""
+    return (a[row, col], a[row, col + 1], a[row, col + 2])
+
+
+@njit(cache=True, inline='always')
+def load9(a, row, col):
+    """Return the 3x3 matrix stored row-major in ``a[row, col:col + 9]``."""
+    return (a[row, col], a[row, col + 1], a[row, col + 2],
+            a[row, col + 3], a[row, col + 4], a[row, col + 5],
+            a[row, col + 6], a[row, col + 7], a[row, col + 8])
+
+
 @njit(cache=True)
 def frame_rot(frames, row):
-    f = frames[row]
-    return (f[0], f[1], f[2], f[3], f[4], f[5], f[6], f[7], f[8])
+    """Return the rotation of a fixed frame (an ``F_*`` row)."""
+    return load9(frames, row, 0)
 
 
 @njit(cache=True)
