@@ -35,17 +35,15 @@ import numpy as np
 
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
                    inverse_dynamics, mass_matrix)
+from .core.drives import model_drives
 from .core.effects import EffectDynamics
+from .core.inertia import format_moments, inertia_matrix, principal_moments
 from .core.model import with_payload
+from .core.text import clip
+from .safety import TorqueGuard, velocity_bounds
 
 EXERTED_BY_ROBOT = 'exerted_by_robot'
 APPLIED_TO_ROBOT = 'applied_to_robot'
-
-
-def clip(text, limit=300):
-    """Return text cut to ``limit`` characters (for logs and messages)."""
-    text = str(text)
-    return text if len(text) <= limit else text[:limit] + '...'
 
 
 class InputRejected(Exception):
@@ -299,13 +297,11 @@ def check_payload(mass, com, inertia6):
     if values.shape != (6,) or not np.isfinite(values).all():
         raise ValueError(f'payload.inertia: must be 6 finite numbers, got '
                          f'{values.tolist()}')
-    ixx, iyy, izz, ixy, iyz, ixz = values
-    inertia = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-    eig = np.linalg.eigvalsh(inertia)
-    if eig[0] < -1e-12 * max(abs(eig).max(), 1e-300):
+    inertia = inertia_matrix(*values)
+    eig, valid = principal_moments(inertia)
+    if not valid:
         raise ValueError(f'payload.inertia: not positive semi-definite '
-                         f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
-                         f'{eig[2]:.6g})')
+                         f'(principal moments {format_moments(eig)})')
     return mass, com, inertia
 
 
@@ -396,18 +392,21 @@ class FeedforwardComputer:
     """
 
     def __init__(self, model, order, wrench_input, reference=None,
-                 scene=None, mode=None):
+                 scene=None, mode=None, *, guard=None, bound_sources=None,
+                 velocity_bounds=None, max_future=1.0, max_age=0.0,
+                 bare_model=None, bare_scene=None):
         self.mode = mode or ('full' if reference is not None
                              else 'gravity_coriolis')
         if self.mode not in MODES:
             raise ValueError(f'mode must be one of {", ".join(MODES)}, got '
                              f'{self.mode!r}')
         self.scene = scene
+        if model is None:
+            model = scene.model
         # the live torques: exactly the scene's effects, or every
         # rigid-body term and the wrench without a scene
-        self.dyn = (EffectDynamics(scene.model, scene.effects,
-                                   scene.viscous, scene.coulomb,
-                                   scene.armature)
+        self.dyn = (EffectDynamics(model, scene.effects, scene.viscous,
+                                   scene.coulomb, scene.armature)
                     if scene is not None else EffectDynamics(model))
         self.model = self.dyn.model
         self.order = order
@@ -418,9 +417,51 @@ class FeedforwardComputer:
         self.zeros = np.zeros(self.model.n)
         self.last_q = None
         self.last_qd = None
+        self.output_names = list(order.output_joints)
+        #: torque bounds and what to do above them (None: unguarded)
+        self.guard = guard
+        self.bound_sources = bound_sources
+        #: speeds above these are implausible (model order; None: off)
+        self.velocity_bounds = velocity_bounds
+        #: joint-state stamp policy (seconds): ahead of now, and age (0: off)
+        self.max_future = max_future
+        self.max_age = max_age
+        self.bare_model = model if bare_model is None else bare_model
+        self.bare_scene = scene if bare_scene is None else bare_scene
+
+    @classmethod
+    def from_parameters(cls, params, model, order, wrench_input, bounds,
+                        bound_sources, reference=None, scene=None, mode=None,
+                        bare_model=None, bare_scene=None):
+        """
+        Build a warm computer from a node's parameters, in one call.
+
+        ``params`` maps parameter names to values (``limits.action``,
+        ``limits.velocity_factor``, ``limits.max_velocity``,
+        ``joint_states.max_future``, ``joint_states.max_age``, and
+        ``drives.compensate`` to add the model's drive terms); ``bounds``
+        and ``bound_sources`` are the torque bounds in model order and
+        where each comes from (``safety.effort_bounds``).  The kernels are
+        compiled or loaded before it returns (:meth:`warm_up`).
+        """
+        ff = cls(model, order, wrench_input, reference, scene, mode,
+                 guard=TorqueGuard(order.to_output_order(bounds),
+                                   params['limits.action']),
+                 bound_sources=[bound_sources[k] for k in order.to_output],
+                 velocity_bounds=velocity_bounds(
+                     model, params['limits.velocity_factor'],
+                     params['limits.max_velocity']),
+                 max_future=params['joint_states.max_future'],
+                 max_age=params['joint_states.max_age'],
+                 bare_model=bare_model, bare_scene=bare_scene)
+        if params.get('drives.compensate'):
+            ff.drives = model_drives(model if bare_model is None
+                                     else bare_model)
+        ff.warm_up()
+        return ff
 
     #: ``core.drives.Drives`` to add (friction, offset, rotor inertia),
-    #: or None; set by the node when ``drives.compensate`` is on
+    #: or None; set by :meth:`from_parameters` with ``drives.compensate``
     drives = None
 
     def _torques(self, q, qd, qdd, w, frame, out=None):
@@ -449,12 +490,6 @@ class FeedforwardComputer:
         coriolis_matrix(self.model, z, z, ws=self.ws)
         gravity_torques(self.model, z, ws=self.ws)
         self._torques(z, z, z, None, 'base')
-
-    #: speeds above these are implausible (model order); set by the node
-    velocity_bounds = None
-    #: joint-state stamp policy (seconds): ahead of now, and age (0: off)
-    max_future = 1.0
-    max_age = 0.0
 
     def check_stamp(self, stamp, now):
         """Reject negative, far-future and (optionally) stale stamps."""

@@ -132,7 +132,3 @@ class TorqueGuard:
         if self.action == 'clamp':
             return np.clip(tau, -self.bounds, self.bounds), True
         return tau, True
-
-    def worst(self, tau):
-        """Index of the joint furthest beyond its bound (for a message)."""
-        return int(np.argmax(np.abs(tau) / self.bounds))

@@ -55,14 +55,14 @@ import timeit
 import warnings
 
 import newton_euler_ros
-from newton_euler_ros.core import _kernels as K
+from newton_euler_ros.core import calling as _calling
 from newton_euler_ros.core import (coriolis_matrix, coriolis_matrix_batch,
                                    forward_dynamics, forward_dynamics_batch,
                                    gravity_torques, gravity_torques_batch,
                                    inverse_dynamics, inverse_dynamics_batch,
                                    load_robot, mass_matrix, mass_matrix_batch,
                                    NewtonEulerError, Workspace)
-from newton_euler_ros.core import dynamics as _dynamics
+from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core.model import REVOLUTE, STANDARD
 import numpy as np
 
@@ -348,56 +348,97 @@ def compare(ref, got):
 # one robot
 
 
-def bench_robot(name, timer, rng, log):
+# statements timed for every robot: one line each.  ``ns`` names (see
+# ``setup_robot``): model, q, qd, qdd, ws, outputs tau D C g, batches Q QD
+# QDD TAU DD W, raw kernel arguments P wsa cw aw scratch zero_w status.
+PUBLIC = {
+    'tau': 'inverse_dynamics(model, q, qd, qdd, ws=ws, out=tau)',
+    'D': 'mass_matrix(model, q, ws=ws, out=D)',
+    'C': 'coriolis_matrix(model, q, qd, ws=ws, out=C)',
+    'g': 'gravity_torques(model, q, ws=ws, out=g)',
+    'FD': 'forward_dynamics(model, q, qd, qdd, ws=ws, out=g)',
+}
+RAW = {
+    'tau': 'K.run_inverse_dynamics(P, q, qd, qdd, zero_w, 3, wsa, tau)',
+    'D': 'K.run_mass_matrix_crba(P, q, wsa, D)',
+    'C': 'K.run_coriolis_matrix(P, q, qd, True, wsa, cw, scratch, C)',
+    'g': 'K.run_gravity_torques(P, q, wsa, g)',
+    'FD': 'K.run_forward_dynamics(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
+}
+NAIVE = {'tau': 'naive_rnea(model, q, qd, qdd)',
+         'D': 'naive_mass_matrix(model, q)',
+         'g': 'naive_rnea(model, q, zeros, zeros)'}
+PIN = {'tau': 'rnea(pm, pd, q, qd, qdd)', 'D': 'crba(pm, pd, q)',
+       'C': 'computeCoriolisMatrix(pm, pd, q, qd)',
+       'g': 'computeGeneralizedGravity(pm, pd, q)',
+       'FD': 'aba(pm, pd, q, qd, qdd)'}
+RTB = {'tau': 'robot.rne(q, qd, qdd)', 'D': 'robot.inertia(q)',
+       'C': 'robot.coriolis(q, qd)', 'g': 'robot.gravload(q)',
+       'FD': 'robot.accel(q, qd, qdd)'}
+# (ours, our raw kernel, one Pinocchio call in its Python loop)
+BATCH_STMTS = {
+    'batch': ('inverse_dynamics_batch(model, Q, QD, QDD, ws=ws, out=TAU)',
+              'K.run_inverse_dynamics_batch(P, Q, QD, QDD, W, 3, wsa, TAU, '
+              'status)', 'rnea(pm, pd, Q[i], QD[i], QDD[i])'),
+    'batch_D': ('mass_matrix_batch(model, Q, ws=ws, out=DD)',
+                'K.run_mass_matrix_batch(P, Q, wsa, DD, status)',
+                'crba(pm, pd, Q[i])'),
+    'batch_C': ('coriolis_matrix_batch(model, Q, QD, ws=ws, out=DD)',
+                'K.run_coriolis_matrix_batch(P, Q, QD, wsa, cw, DD, status)',
+                'computeCoriolisMatrix(pm, pd, Q[i], QD[i])'),
+    'batch_g': ('gravity_torques_batch(model, Q, ws=ws, out=TAU)',
+                'K.run_gravity_torques_batch(P, Q, wsa, TAU, status)',
+                'computeGeneralizedGravity(pm, pd, Q[i])'),
+    'batch_FD': ('forward_dynamics_batch(model, Q, QD, QDD, ws=ws, out=TAU)',
+                 'K.run_forward_dynamics_batch(P, Q, QD, QDD, W, 3, wsa, aw, '
+                 'TAU, status)', 'aba(pm, pd, Q[i], QD[i], QDD[i])'),
+}
+# tau with its inputs given otherwise than as float64 arrays, beside the
+# float64 row: a list or an int array costs one conversion more
+INPUT_ROWS = {
+    'q list': 'inverse_dynamics(model, q_list, qd, qdd, ws=ws, out=tau)',
+    'q int array': 'inverse_dynamics(model, q_int, qd, qdd, ws=ws, out=tau)',
+    'all lists': 'inverse_dynamics(model, q_list, qd_list, qdd_list, '
+                 'wrench_list, ws=ws, out=tau)',
+    'wrench array': 'inverse_dynamics(model, q, qd, qdd, wrench, ws=ws, '
+                    'out=tau)',
+    'wrench list': 'inverse_dynamics(model, q, qd, qdd, wrench_list, ws=ws, '
+                   'out=tau)',
+}
+PROBES = {
+    'empty_loop': 'pass',
+    'njit_0_args': 'noop0()',
+    'njit_1_array': 'noop1(q)',
+    'njit_tau_args': 'noop_tau(P, q, qd, qdd, zero_w, 3, wsa, tau)',
+    'njit_D_args': 'noop4(P, q, wsa, D)',
+    'njit_C_args': 'noop_c(P, q, qd, True, wsa, cw, scratch, C)',
+    'njit_g_args': 'noop4(P, q, wsa, g)',
+    'njit_FD_args': 'noop_fd(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
+    '_vector_one_arg': "_vector('q', q, n)",
+    'np_empty_n': 'np.empty(n)',
+}
+
+
+def setup_robot(name, rng, log):
+    """Load a robot; return (result skeleton, our namespace, states)."""
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')     # e.g. the Puma's published
         model = load_robot(name)            # triangle-inequality oddities
     n = model.n
     result = {'robot': name, 'convention': model.convention, 'dof': n,
               'timings': {}, 'correctness': {}, 'valid': {}}
-    T = result['timings']
     log(f'\n=== {name}: {model.convention} DH, {n} DoF '
         f'({", ".join(sorted(set(model.joint_types)))}) ===')
-
     ws = Workspace(model)
     q, qd, qdd = random_state(model, rng)
-    tau = np.empty(n)
-    D = np.empty((n, n))
-    C = np.empty((n, n))
-    g = np.empty(n)
     Q, QD, QDD = random_states(model, rng, BATCH_STATES)
     m = BATCH_STATES
-    TAU = np.empty((m, n))
-    W = np.zeros((m, 6))
-    check_states = [random_state(model, rng) for _ in range(3)]
-    ref = ours_reference(model, check_states)
-
-    # ---- correctness of the references before any timing ----
-    log('correctness, max |ours - other| over 3 random states '
-        '(tolerance 1e-9 x max(1, |ours|)):')
-    naive_out = [{'tau': naive_rnea(model, *s),
-                  'g': naive_rnea(model, s[0], np.zeros(n), np.zeros(n)),
-                  'D': naive_mass_matrix(model, s[0])} for s in check_states]
-    diffs, ok = compare(ref, naive_out)
-    result['correctness']['naive'] = diffs
-    result['valid']['naive'] = all(ok.values())
-    log('  naive numpy : ' + _fmt_diffs(diffs, ok))
-    Qc = np.array([s[0] for s in check_states])
-    bat = inverse_dynamics_batch(model, Qc, [s[1] for s in check_states],
-                                 [s[2] for s in check_states])
-    bdiff = max(_maxdiff(bat[i], ref[i]['tau']) for i in range(len(ref)))
-    log(f'  our batch   : tau {bdiff:.1e} vs single-state')
-    result['correctness']['ours_batch_vs_single'] = bdiff
-
-    pin_ns = _setup_pinocchio(model, check_states, ref, result, log)
-    rtb_ns = _setup_rtb(model, check_states, ref, result, log)
-
-    # ---- our public API and raw kernels ----
-    W = np.zeros((m, 6))
+    wrench = np.array([0.0, 0.0, 10.0, 0.0, 0.0, 0.0])
     ns = {'model': model, 'q': q, 'qd': qd, 'qdd': qdd, 'ws': ws,
-          'tau': tau, 'D': D, 'C': C, 'g': g, 'Q': Q, 'QD': QD, 'QDD': QDD,
-          'TAU': TAU, 'W': W, 'K': K, 'P': model.packed,
-          'DD': np.empty((m, n, n)),
+          'tau': np.empty(n), 'D': np.empty((n, n)), 'C': np.empty((n, n)),
+          'g': np.empty(n), 'Q': Q, 'QD': QD, 'QDD': QDD,
+          'TAU': np.empty((m, n)), 'W': np.zeros((m, 6)), 'K': K,
+          'P': model.packed, 'DD': np.empty((m, n, n)),
           'inverse_dynamics': inverse_dynamics, 'mass_matrix': mass_matrix,
           'coriolis_matrix': coriolis_matrix,
           'gravity_torques': gravity_torques,
@@ -410,69 +451,66 @@ def bench_robot(name, timer, rng, log):
           'naive_rnea': naive_rnea, 'naive_mass_matrix': naive_mass_matrix,
           'zeros': np.zeros(n), 'zero_w': np.zeros(6), 'wsa': ws.ws,
           'scratch': ws.scratch, 'cw': ws.cw, 'aw': ws.aw,
-          'status': ws.status, '_vector': _dynamics._vector, 'n': n}
-    stmts = {
-        'tau': 'inverse_dynamics(model, q, qd, qdd, ws=ws, out=tau)',
-        'D': 'mass_matrix(model, q, ws=ws, out=D)',
-        'C': 'coriolis_matrix(model, q, qd, ws=ws, out=C)',
-        'g': 'gravity_torques(model, q, ws=ws, out=g)',
-        'FD': 'forward_dynamics(model, q, qd, qdd, ws=ws, out=g)',
-    }
-    raw = {
-        'tau': 'K.run_inverse_dynamics(P, q, qd, qdd, zero_w, 3, wsa, tau)',
-        'D': 'K.run_mass_matrix_crba(P, q, wsa, D)',
-        'C': 'K.run_coriolis_matrix(P, q, qd, True, wsa, cw, scratch, C)',
-        'g': 'K.run_gravity_torques(P, q, wsa, g)',
-        'FD': 'K.run_forward_dynamics(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
-    }
-    probes_fns = _dispatch_probes()
-    ns.update(probes_fns, np=np)
-    naive = {'tau': 'naive_rnea(model, q, qd, qdd)',
-             'D': 'naive_mass_matrix(model, q)',
-             'g': 'naive_rnea(model, q, zeros, zeros)'}
-    pin = {'tau': 'rnea(pm, pd, q, qd, qdd)', 'D': 'crba(pm, pd, q)',
-           'C': 'computeCoriolisMatrix(pm, pd, q, qd)',
-           'g': 'computeGeneralizedGravity(pm, pd, q)',
-           'FD': 'aba(pm, pd, q, qd, qdd)'}
-    rtb = {'tau': 'robot.rne(q, qd, qdd)', 'D': 'robot.inertia(q)',
-           'C': 'robot.coriolis(q, qd)', 'g': 'robot.gravload(q)',
-           'FD': 'robot.accel(q, qd, qdd)'}
+          'status': ws.status, '_vector': _calling.vector, 'n': n,
+          'np': np, 'wrench': wrench, 'wrench_list': wrench.tolist(),
+          'q_list': q.tolist(), 'qd_list': qd.tolist(),
+          'qdd_list': qdd.tolist(),
+          'q_int': np.round(q).astype(np.int64)}
+    ns.update(_dispatch_probes())
+    check_states = [random_state(model, rng) for _ in range(3)]
+    return result, ns, check_states
+
+
+def check_references(result, ns, states, log):
+    """Check the naive recursion and the peers against ours; peer spaces."""
+    model = ns['model']
+    n = model.n
+    ref = ours_reference(model, states)
+    log('correctness, max |ours - other| over 3 random states '
+        '(tolerance 1e-9 x max(1, |ours|)):')
+    naive_out = [{'tau': naive_rnea(model, *s),
+                  'g': naive_rnea(model, s[0], np.zeros(n), np.zeros(n)),
+                  'D': naive_mass_matrix(model, s[0])} for s in states]
+    diffs, ok = compare(ref, naive_out)
+    result['correctness']['naive'] = diffs
+    result['valid']['naive'] = all(ok.values())
+    log('  naive numpy : ' + _fmt_diffs(diffs, ok))
+    Qc = np.array([s[0] for s in states])
+    bat = inverse_dynamics_batch(model, Qc, [s[1] for s in states],
+                                 [s[2] for s in states])
+    bdiff = max(_maxdiff(bat[i], ref[i]['tau']) for i in range(len(ref)))
+    log(f'  our batch   : tau {bdiff:.1e} vs single-state')
+    result['correctness']['ours_batch_vs_single'] = bdiff
+    pin_ns = _setup_pinocchio(model, states, ref, result, log)
+    rtb_ns = _setup_rtb(model, states, ref, result, log)
     for extra in (pin_ns, rtb_ns):
         if extra is not None:
-            extra.update(q=q, qd=qd, qdd=qdd, Q=Q, QD=QD, QDD=QDD)
+            extra.update({k: ns[k] for k in ('q', 'qd', 'qdd', 'Q', 'QD',
+                                             'QDD')})
+    return pin_ns, rtb_ns
 
-    # one group per operation: ours, our raw kernel and every peer, their
-    # repeats interleaved
+
+def measure_single(timer, ns, pin_ns, rtb_ns):
+    """One group per operation: ours, our raw kernel and every peer."""
+    T = {}
     for op in SINGLE:
-        entries = {('ours', op): (stmts[op], ns, None, 1),
-                   ('ours_raw', op): (raw[op], ns, None, 1)}
+        entries = {('ours', op): (PUBLIC[op], ns, None, 1),
+                   ('ours_raw', op): (RAW[op], ns, None, 1)}
         if pin_ns is not None:
-            entries[('pin', op)] = (pin[op], pin_ns, None, 1)
+            entries[('pin', op)] = (PIN[op], pin_ns, None, 1)
         if rtb_ns is not None:
-            entries[('rtb', op)] = (rtb[op], rtb_ns, None, 1)
-        if op in naive:
-            entries[('naive', op)] = (naive[op], ns, None, 1)
+            entries[('rtb', op)] = (RTB[op], rtb_ns, None, 1)
+        if op in NAIVE:
+            entries[('naive', op)] = (NAIVE[op], ns, None, 1)
         T.update(timer.group(entries))
-    batch = {
-        'batch': ('inverse_dynamics_batch(model, Q, QD, QDD, ws=ws, '
-                  'out=TAU)', 'K.run_inverse_dynamics_batch(P, Q, QD, QDD, '
-                  'W, 3, wsa, TAU, status)', 'rnea(pm, pd, Q[i], QD[i], '
-                  'QDD[i])'),
-        'batch_D': ('mass_matrix_batch(model, Q, ws=ws, out=DD)',
-                    'K.run_mass_matrix_batch(P, Q, wsa, DD, status)',
-                    'crba(pm, pd, Q[i])'),
-        'batch_C': ('coriolis_matrix_batch(model, Q, QD, ws=ws, out=DD)',
-                    'K.run_coriolis_matrix_batch(P, Q, QD, wsa, cw, DD, '
-                    'status)', 'computeCoriolisMatrix(pm, pd, Q[i], QD[i])'),
-        'batch_g': ('gravity_torques_batch(model, Q, ws=ws, out=TAU)',
-                    'K.run_gravity_torques_batch(P, Q, wsa, TAU, status)',
-                    'computeGeneralizedGravity(pm, pd, Q[i])'),
-        'batch_FD': ('forward_dynamics_batch(model, Q, QD, QDD, ws=ws, '
-                     'out=TAU)', 'K.run_forward_dynamics_batch(P, Q, QD, '
-                     'QDD, W, 3, wsa, aw, TAU, status)',
-                     'aba(pm, pd, Q[i], QD[i], QDD[i])'),
-    }
-    for op, (public, kernel, pin_call) in batch.items():
+    return T
+
+
+def measure_batches(timer, ns, pin_ns, rtb_ns):
+    """Per state: our batch call, its raw kernel and a Pinocchio loop."""
+    T = {}
+    m = BATCH_STATES
+    for op, (public, kernel, pin_call) in BATCH_STMTS.items():
         entries = {('ours', op): (public, ns, 1, m),
                    ('ours_raw', op): (kernel, ns, 1, m)}
         if pin_ns is not None:
@@ -482,23 +520,32 @@ def bench_robot(name, timer, rng, log):
         if rtb_ns is not None and op == 'batch':
             entries[('rtb', op)] = ('robot.rne(Q, QD, QDD)', rtb_ns, 1, m)
         T.update(timer.group(entries))
+    return T
 
-    # ---- where the time goes ----
-    probes = {
-        'empty_loop': 'pass',
-        'njit_0_args': 'noop0()',
-        'njit_1_array': 'noop1(q)',
-        'njit_tau_args': 'noop_tau(P, q, qd, qdd, zero_w, 3, wsa, tau)',
-        'njit_D_args': 'noop4(P, q, wsa, D)',
-        'njit_C_args': 'noop_c(P, q, qd, True, wsa, cw, scratch, C)',
-        'njit_g_args': 'noop4(P, q, wsa, g)',
-        'njit_FD_args': 'noop_fd(P, q, qd, qdd, zero_w, 3, wsa, aw, g)',
-        '_vector_one_arg': "_vector('q', q, n)",
-        'np_empty_n': 'np.empty(n)',
-    }
-    T.update(timer.group({('probe', key): (stmt, ns, None, 1)
-                          for key, stmt in probes.items()}))
 
+def measure_inputs(timer, ns):
+    """Time tau from float64 arrays, lists and int arrays, interleaved."""
+    entries = {('inputs', 'float64 arrays'): (PUBLIC['tau'], ns, None, 1)}
+    entries.update({('inputs', key): (stmt, ns, None, 1)
+                    for key, stmt in INPUT_ROWS.items()})
+    return timer.group(entries)
+
+
+def measure_probes(timer, ns):
+    """Where the time goes: dispatch of do-nothing functions, pieces."""
+    return timer.group({('probe', key): (stmt, ns, None, 1)
+                        for key, stmt in PROBES.items()})
+
+
+def bench_robot(name, timer, rng, log):
+    """Set up, check and time one robot; the result of :func:`main`."""
+    result, ns, states = setup_robot(name, rng, log)
+    pin_ns, rtb_ns = check_references(result, ns, states, log)
+    T = result['timings']
+    T.update(measure_single(timer, ns, pin_ns, rtb_ns))
+    T.update(measure_batches(timer, ns, pin_ns, rtb_ns))
+    T.update(measure_inputs(timer, ns))
+    T.update(measure_probes(timer, ns))
     result['verdicts'] = verdicts(result)
     return result
 
@@ -662,6 +709,18 @@ def print_table(result, timer, log):
     log('  D: Pinocchio crba fills only the upper triangle; ours and RTB '
         'return the full matrix.  RTB inertia = n rne calls, coriolis = '
         'n(n+1)/2 rne calls from Python, accel = a solve with its inertia.')
+
+
+def print_inputs(result, log):
+    """Print the tau row from other input types, beside the float64 row."""
+    T = result['timings']
+    rows = [k[1] for k in T if k[0] == 'inputs']
+    base = T[('inputs', 'float64 arrays')]['min_us']
+    log(f'\n{result["robot"]}: tau = ID(q,qd,qdd) by input type, min '
+        f'(median) us per call; the extra is the conversion')
+    for key in rows:
+        t = T[('inputs', key)]
+        log(f'  {key:<16}{_cell(t):>16}  {t["min_us"] / base:5.2f}x')
 
 
 def print_breakdown(result, log):
@@ -888,6 +947,7 @@ def main(argv=None):
     log('=' * 78)
     for result in results:
         print_table(result, timer, log)
+        print_inputs(result, log)
         print_breakdown(result, log)
         print_misses(result, log)
     print_first_call(first, log)

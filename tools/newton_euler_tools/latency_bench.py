@@ -719,7 +719,8 @@ def print_table(phases):
                if 'torque_command_received' in r else ''))
 
 
-def main(argv=None):
+def parse_args(argv=None):
+    """Return the command line's options (``--quick`` applied)."""
     parser = argparse.ArgumentParser(
         prog='python -m newton_euler_tools.latency_bench',
         description='Latency of inverse_dynamics_node (joint state in, '
@@ -791,21 +792,11 @@ def main(argv=None):
             parser.error(str(exc))
     if not 0 <= args.domain <= 229:
         parser.error('--domain must be in 0..229')
+    return args
 
-    build_dir = _default_dirs()
-    prepare_environment(build_dir)
-    logs_dir = os.path.join(build_dir, 'latency_bench')
-    # SIGTERM: unwind through the finally blocks that stop the children
-    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
 
-    from importlib import metadata
-    try:
-        rclpy_version = metadata.version('rclpy')
-    except metadata.PackageNotFoundError:
-        rclpy_version = '?'
-    args.limits = joint_limits()
-    slack = False if args.no_timer_slack else set_timer_slack(1)
-    load_start = _loadavg()
+def print_header(args, rclpy_version, slack, load_start):
+    """Log the set-up: rate, versions, machine load, the bench's timing."""
     log(f'newton_euler_ros latency benchmark: {args.rate:.0f} Hz x '
         f'{args.duration:g} s per phase; python '
         f'{platform.python_version()}, rclpy {rclpy_version}, '
@@ -821,10 +812,12 @@ def main(argv=None):
         f'spinning the {args.bench_executor} executor; switch interval '
         f'{args.switch_us:g} us during timing')
 
-    phases = []
+
+def phase_plan(args):
+    """(key, label, domain, command, topic, env) of each phase to run."""
     node_cmd = (shlex.split(args.node_cmd) if args.node_cmd
                 else node_command())
-    plan = [('node', f'{NODE_NAME}', args.domain, node_cmd, NODE_TOPIC, None),
+    return [('node', f'{NODE_NAME}', args.domain, node_cmd, NODE_TOPIC, None),
             ('events', f'{NODE_NAME}, events', args.domain + 3, node_cmd,
              NODE_TOPIC, {'NEWTON_EULER_EXECUTOR': 'events'}),
             ('echo', 'echo_node (floor)', args.domain + 1,
@@ -832,28 +825,10 @@ def main(argv=None):
              ECHO_TOPIC, None),
             ('loop', 'bench self-loop', args.domain + 2, None, LOOP_TOPIC,
              None)]
-    by_key = {}
-    t_start = time.monotonic()
-    try:
-        for key, label, domain, cmd, topic, env in plan:
-            if key in args.skip:
-                continue
-            result, _ = run_phase(key, label, domain, cmd, topic, args,
-                                  logs_dir, env)
-            result['key'] = key
-            phases.append(result)
-            by_key[key] = result
-    except BenchError as exc:
-        print(f'latency_bench: {exc}', file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print('latency_bench: interrupted', file=sys.stderr)
-        return 130
 
-    load_end = _loadavg()
-    log('\n' + '=' * 78)
-    log('RESULTS')
-    log('=' * 78)
+
+def report(phases, by_key):
+    """Log the table, the node/echo verdicts; return (summary, missed)."""
     print_table(phases)
     summary = None
     missed = False
@@ -890,28 +865,80 @@ def main(argv=None):
         codes = ', '.join(f'{r["label"]} {r["exit_code"]}'
                           for r in phases if 'exit_code' in r)
         log(f'child exit codes after SIGINT: {codes}')
+    return summary, missed
+
+
+def write_json(args, rclpy_version, slack, load_start, load_end, phases,
+               summary):
+    """Write every figure of the run to ``args.json``."""
+    payload = {
+        'rate_hz': args.rate, 'duration_s': args.duration,
+        'seed': args.seed, 'domain': args.domain,
+        'python': platform.python_version(), 'rclpy': rclpy_version,
+        'cpus': os.cpu_count(), 'load_average_start': load_start,
+        'load_average_end': load_end,
+        'bench': {'executor': args.bench_executor,
+                  'spin_us': args.spin_us, 'switch_us': args.switch_us,
+                  'timer_slack_1ns': slack, 'preroll_s': args.preroll,
+                  'drain_s': args.drain},
+        'targets': {'p99_us': TARGET_P99_US,
+                    'overhead_over_echo': TARGET_OVERHEAD},
+        'phases': phases, 'summary': summary,
+    }
+    os.makedirs(os.path.dirname(os.path.abspath(args.json)),
+                exist_ok=True)
+    with open(args.json, 'w') as fh:
+        json.dump(payload, fh, indent=1)
+    log(f'wrote {args.json}')
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    build_dir = _default_dirs()
+    prepare_environment(build_dir)
+    logs_dir = os.path.join(build_dir, 'latency_bench')
+    # SIGTERM: unwind through the finally blocks that stop the children
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+
+    from importlib import metadata
+    try:
+        rclpy_version = metadata.version('rclpy')
+    except metadata.PackageNotFoundError:
+        rclpy_version = '?'
+    args.limits = joint_limits()
+    slack = False if args.no_timer_slack else set_timer_slack(1)
+    load_start = _loadavg()
+    print_header(args, rclpy_version, slack, load_start)
+
+    phases = []
+    by_key = {}
+    t_start = time.monotonic()
+    try:
+        for key, label, domain, cmd, topic, env in phase_plan(args):
+            if key in args.skip:
+                continue
+            result, _ = run_phase(key, label, domain, cmd, topic, args,
+                                  logs_dir, env)
+            result['key'] = key
+            phases.append(result)
+            by_key[key] = result
+    except BenchError as exc:
+        print(f'latency_bench: {exc}', file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print('latency_bench: interrupted', file=sys.stderr)
+        return 130
+
+    load_end = _loadavg()
+    log('\n' + '=' * 78)
+    log('RESULTS')
+    log('=' * 78)
+    summary, missed = report(phases, by_key)
     log(f'load average at end: {_fmt_load(load_end)} (includes this '
         f'benchmark); took {time.monotonic() - t_start:.0f} s')
     if args.json:
-        payload = {
-            'rate_hz': args.rate, 'duration_s': args.duration,
-            'seed': args.seed, 'domain': args.domain,
-            'python': platform.python_version(), 'rclpy': rclpy_version,
-            'cpus': os.cpu_count(), 'load_average_start': load_start,
-            'load_average_end': load_end,
-            'bench': {'executor': args.bench_executor,
-                      'spin_us': args.spin_us, 'switch_us': args.switch_us,
-                      'timer_slack_1ns': slack, 'preroll_s': args.preroll,
-                      'drain_s': args.drain},
-            'targets': {'p99_us': TARGET_P99_US,
-                        'overhead_over_echo': TARGET_OVERHEAD},
-            'phases': phases, 'summary': summary,
-        }
-        os.makedirs(os.path.dirname(os.path.abspath(args.json)),
-                    exist_ok=True)
-        with open(args.json, 'w') as fh:
-            json.dump(payload, fh, indent=1)
-        log(f'wrote {args.json}')
+        write_json(args, rclpy_version, slack, load_start, load_end, phases,
+                   summary)
     return 1 if (args.strict and missed) else 0
 
 

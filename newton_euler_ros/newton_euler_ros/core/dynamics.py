@@ -19,9 +19,10 @@ The equation of motion is
 
     D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau        (seed eq. 23)
 
-Every term comes from the compiled kernels of ``_kernels`` (the one
+Every term comes from the compiled kernels of ``kernels`` (the one
 Newton-Euler recursion, and the composite-body and articulated-body
-algorithms built on the same model):
+algorithms built on the same model; ``docs/how-it-is-computed.md`` maps
+each to its file):
 
 ==========================  =============================================
 :func:`inverse_dynamics`    tau for (q, qd, qdd, F_e); O(n)
@@ -49,12 +50,14 @@ Batches.  ``inverse_dynamics_batch``, ``mass_matrix_batch``,
 ``forward_dynamics_batch`` take (m, n) arrays of states and run one
 compiled loop over them: no Python work per state.
 
-Cost per call.  The kernels are called through dispatchers compiled for
-exactly float64, C-contiguous arrays (``_strict``): such arguments go
-straight in, and the kernels check sizes and finiteness themselves and
-return a status code.  Anything else (lists, other dtypes, read-only or
-strided arrays) is refused by the dispatcher, converted once here, and
-the call repeated; bad arguments get the same one-line errors either way.
+Cost per call.  Each function calls a *strict entry* of its kernel
+(registered below, one line per term): a dispatcher compiled for exactly
+float64, C-contiguous arrays, so such arguments go straight in and the
+kernel checks sizes and finiteness itself, returning a status code.
+Anything else (lists, other dtypes, read-only or strided arrays) is
+refused by the dispatcher at once, converted once, and the call made
+again; every error is decoded in one place (``calling.status_error``).
+See :mod:`newton_euler_ros.core.calling`.
 
 Examples
 --------
@@ -66,167 +69,46 @@ Examples
 True
 
 """
-from numba import njit, types
 import numpy as np
 
-from . import _kernels as K
-from .errors import DynamicsInputError, NotPositiveDefiniteError
-from .workspace import Workspace
+from . import kernels as K
+from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
+                    gravity_torques_batch, inverse_dynamics_batch,
+                    mass_matrix_batch)
+from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
+                      first_singular_pivot, foreign_workspace, FORWARD_DYNAMICS_METHODS, INT,
+                      MASS_MATRIX_METHODS, MAT, not_positive_definite,
+                      out_array, PACKED, Refused, status_error, strict_entry,
+                      VEC, vector, workspace, WRENCH_FRAMES, wrench_mode)
+from .errors import DynamicsInputError
 
-
-_WRENCH_FRAMES = {'base': K.WRENCH_BASE, 'end_effector': K.WRENCH_EE}
-_INPUTS = ('q', 'qd', 'qdd', 'wrench')
-_FD_INPUTS = ('q', 'qd', 'tau', 'wrench')
-
-# ---------------------------------------------------------------------------
-# strict dispatchers: float64 C arrays only, compiled (or loaded from the
-# cache) on first use
-
-_F8 = types.float64
-_V = types.Array(_F8, 1, 'C')
-_M = types.Array(_F8, 2, 'C')
-_T = types.Array(_F8, 3, 'C')
-_P = types.Array(_F8, 2, 'C', readonly=True)
-_I = types.int64
-_B = types.boolean
-
-
-def _strict(name, kernel, *argtypes):
-    """
-    Return a loader that replaces global ``name`` by a strict dispatcher.
-
-    The dispatcher is compiled for ``argtypes`` only and compiles nothing
-    else: other argument types raise TypeError at once, which the callers
-    take as the cue to convert their arguments.  It takes the entry
-    points' options (``_kernels.ENTRY``): numba's cache does not tell
-    compilations of one function with other options apart.
-    """
-    def load(*args):
-        strict = njit(types.int64(*argtypes), **K.ENTRY)(kernel.py_func)
-        globals()[name] = strict
-        return strict(*args)
-    return load
-
-
-_tau = _strict('_tau', K.run_inverse_dynamics, _P, _V, _V, _V, _V, _I, _M,
-               _V)
-_gravity = _strict('_gravity', K.run_gravity_torques, _P, _V, _M, _V)
-_crba = _strict('_crba', K.run_mass_matrix_crba, _P, _V, _M, _M)
-_mass = _strict('_mass', K.run_mass_matrix, _P, _V, _B, _M, _M, _M)
-_coriolis = _strict('_coriolis', K.run_coriolis_matrix, _P, _V, _V, _B, _M,
-                    _M, _M, _M)
-_aba = _strict('_aba', K.run_forward_dynamics, _P, _V, _V, _V, _V, _I, _M,
-               _M, _V)
-_jac = _strict('_jac', K.run_jacobian, _P, _V, _B, _M, _M, _M)
-_poses = _strict('_poses', K.run_link_poses, _P, _V, _M, _M)
-
+__all__ = [
+    'CORIOLIS_METHODS', 'FORWARD_DYNAMICS_METHODS', 'MASS_MATRIX_METHODS',
+    'coriolis_matrix', 'coriolis_matrix_batch', 'end_effector_pose',
+    'first_singular_pivot', 'forward_dynamics', 'forward_dynamics_batch',
+    'gravity_torques', 'gravity_torques_batch', 'inverse_dynamics',
+    'inverse_dynamics_batch', 'jacobian', 'link_poses', 'mass_matrix',
+    'mass_matrix_batch', 'mass_matrix_condition', 'solve_mass_matrix',
+    'velocity_products', 'wrench_torques',
+]
 
 # ---------------------------------------------------------------------------
-# arguments, conversions and errors
+# the strict entries: one registration per kernel entry point (argument
+# types as the entry point takes them; see calling.strict_entry)
 
-def _workspace(model, ws):
-    """Return ``ws`` once checked against the model (None: the default)."""
-    if ws is None:
-        return model.default_workspace
-    if type(ws) is not Workspace or ws.n != model.n \
-            or ws.dtype != np.float64:
-        raise DynamicsInputError(
-            f'ws must be a float64 Workspace for a model of {model.n} '
-            f'joints, got {ws!r}')
-    return ws
+_tau = strict_entry(K.run_inverse_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
+                    MAT, VEC)
+_gravity = strict_entry(K.run_gravity_torques, PACKED, VEC, MAT, VEC)
+_crba = strict_entry(K.run_mass_matrix_crba, PACKED, VEC, MAT, MAT)
+_mass = strict_entry(K.run_mass_matrix, PACKED, VEC, BOOL, MAT, MAT, MAT)
+_coriolis = strict_entry(K.run_coriolis_matrix, PACKED, VEC, VEC, BOOL, MAT,
+                         MAT, MAT, MAT)
+_aba = strict_entry(K.run_forward_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
+                    MAT, MAT, VEC)
+_jac = strict_entry(K.run_jacobian, PACKED, VEC, BOOL, MAT, MAT, MAT)
+_poses = strict_entry(K.run_link_poses, PACKED, VEC, MAT, MAT)
 
-
-def _vector(name, x, size):
-    """Return x as a contiguous float64 vector of the given size, or raise."""
-    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1
-            and x.flags.c_contiguous and x.flags.writeable):
-        arr = x
-    else:
-        try:
-            arr = np.array(x, dtype=np.float64)
-        except (TypeError, ValueError) as exc:
-            raise DynamicsInputError(
-                f'{name} must be a sequence of {size} numbers: {exc}') from None
-        if arr.ndim != 1:
-            raise DynamicsInputError(
-                f'{name} must be a vector of {size} numbers, '
-                f'got shape {arr.shape}')
-    if arr.shape[0] != size:
-        raise DynamicsInputError(
-            f'{name} must have {size} entries, got {arr.shape[0]}')
-    return arr
-
-
-def _out(out, shape, dtype=np.float64):
-    """Return a new array of ``shape``, or ``out`` once checked."""
-    if out is None:
-        return np.empty(shape, dtype)
-    if (type(out) is not np.ndarray or out.dtype != dtype
-            or out.shape != shape or not out.flags.c_contiguous
-            or not out.flags.writeable):
-        raise DynamicsInputError(
-            f'out must be a writeable, C-contiguous {np.dtype(dtype).name} '
-            f'array of shape {shape}, got '
-            + (f'{out.dtype} {out.shape}' if isinstance(out, np.ndarray)
-               else type(out).__name__))
-    return out
-
-
-def _raise_nonfinite(code, values, precision='float64', names=_INPUTS):
-    if code == K.OVERFLOW:
-        raise DynamicsInputError(
-            f'the result overflows {precision} (inputs too large); nothing '
-            f'is returned')
-    arg, i = divmod(code, 1000)
-    raise DynamicsInputError(
-        f'{names[arg]}[{i}] is {float(values[arg][i])!r}; every entry must '
-        f'be finite')
-
-
-def _raise_status(code, values, names=_INPUTS):
-    """Raise the error a kernel's status code (>= 0) stands for."""
-    if K.SIZE <= code < K.SIZE + 6:
-        # sizes are checked in Python before a retry; only a workspace of
-        # another size can get here
-        raise DynamicsInputError(
-            'ws does not fit this model (made for another number of joints)')
-    _raise_nonfinite(code, values, names=names)
-
-
-def _wrench_mode(wrench, wrench_frame):
-    if wrench is None:
-        return K.WRENCH_NONE
-    try:
-        return _WRENCH_FRAMES[wrench_frame]
-    except KeyError:
-        raise DynamicsInputError(
-            f"wrench_frame must be 'base' or 'end_effector', "
-            f'got {wrench_frame!r}') from None
-
-
-def _flags(gravity, velocity_products, mode):
-    return ((K.GRAVITY if gravity else 0)
-            | (K.VELOCITY if velocity_products else 0)
-            | (mode << K.WRENCH_SHIFT))
-
-
-def _not_positive_definite(model, q, j, ws):
-    """
-    Return the NotPositiveDefiniteError for a singular D (first joint).
-
-    The articulated-body algorithm meets the singularity from the tip; the
-    joint named is the first one (from the base) at which the leading
-    block of D stops being positive definite, as a Cholesky factorisation
-    finds it, so both methods name the same joint.
-    """
-    D = mass_matrix(model, q, ws=ws)
-    bad = K.cholesky_solve(D, ws.zeros, ws.chol, np.empty(model.n))
-    if bad < 0:
-        bad = j
-    return NotPositiveDefiniteError(
-        f'the mass matrix is not positive definite at joint {bad} '
-        f'({model.joint_names[bad]}): no mass or inertia moves with that '
-        f'joint given the joints before it', bad)
+assert (K.GRAVITY, K.VELOCITY, K.WRENCH_SHIFT) == (1, 2, 2)  # literals below
 
 
 # ---------------------------------------------------------------------------
@@ -264,11 +146,11 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
         N m for revolute and N for prismatic joints.
 
     """
-    # the fast path: no Python checks (the kernel checks sizes and values)
     w = model.default_workspace if ws is None else ws
-    flags = (1 if gravity else 0) | (2 if velocity_products else 0)
+    flags = 3 if gravity is True and velocity_products is True else (
+        (1 if gravity else 0) | (2 if velocity_products else 0))
     if wrench is not None:
-        flags |= _wrench_mode(wrench, wrench_frame) << K.WRENCH_SHIFT
+        flags |= wrench_mode(wrench, wrench_frame) << 2
     try:
         tau = np.empty(w.n) if out is None else out
         if _tau(model.packed, q, w.zeros if qd is None else qd,
@@ -276,33 +158,26 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
                 w.zero_wrench if wrench is None else wrench, flags, w.ws,
                 tau) < 0:
             return tau
-    except (TypeError, AttributeError):
+    except Refused:
         pass
-    return _rnea_converted(model, ws, q, qd, qdd, wrench, flags, out)
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
+    return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
 
 
-assert (K.GRAVITY, K.VELOCITY) == (1, 2)    # the literals above
-
-
-def _rnea_converted(model, ws, q, qd, qdd, wrench, flags, out):
-    """
-    Call the Newton-Euler kernel again, arguments converted and checked.
-
-    Taken when the strict dispatcher refuses an argument's type or the
-    kernel reports a problem: every error is raised from here, naming the
-    argument and the index.
-    """
-    ws = _workspace(model, ws)
+def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
+    """Call the Newton-Euler entry again, its arguments converted once."""
+    ws = workspace(model, ws)
     n = ws.n
-    q = _vector('q', q, n)
-    qd = ws.zeros if qd is None else _vector('qd', qd, n)
-    qdd = ws.zeros if qdd is None else _vector('qdd', qdd, n)
-    wrench = (ws.zero_wrench if wrench is None
-              else _vector('wrench', wrench, 6))
-    tau = _out(out, (n,))
-    bad = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
-    if bad >= 0:
-        _raise_status(bad, (q, qd, qdd, wrench))
+    q = vector('q', q, n)
+    qd = ws.zeros if qd is None else vector('qd', qd, n)
+    qdd = ws.zeros if qdd is None else vector('qdd', qdd, n)
+    wrench = ws.zero_wrench if wrench is None else vector('wrench', wrench, 6)
+    tau = out_array(out, (n,))
+    code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
+    if code >= 0:
+        raise status_error(code, (q, qd, qdd, wrench))
     return tau
 
 
@@ -313,9 +188,12 @@ def gravity_torques(model, q, *, ws=None, out=None):
         tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
-    except (TypeError, AttributeError):
+    except Refused:
         pass
-    return _rnea_converted(model, ws, q, None, None, None, K.GRAVITY, out)
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
+    return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
 
 
 def velocity_products(model, q, qd, *, ws=None, out=None):
@@ -323,24 +201,13 @@ def velocity_products(model, q, qd, *, ws=None, out=None):
     return inverse_dynamics(model, q, qd, None, gravity=False, ws=ws, out=out)
 
 
-MASS_MATRIX_METHODS = ('newton_euler', 'crba')
-CORIOLIS_METHODS = ('composite', 'newton_euler')
-FORWARD_DYNAMICS_METHODS = ('aba', 'cholesky')
-
-
-def _bad_method(method, methods=MASS_MATRIX_METHODS):
-    return ValueError(
-        f'method must be one of {", ".join(map(repr, methods))}'
-        f', got {method!r}')
-
-
 def mass_matrix(model, q, *, method='crba', ws=None, out=None):
     """
     Joint-space inertia matrix D(q), (n, n), symmetric positive definite.
 
     ``method='crba'`` (the default): the composite-rigid-body algorithm
-    (``_kernels.mass_matrix_crba``), O(n^2) with a small constant and
-    symmetric by construction.  ``method='newton_euler'``: column k is the
+    (``kernels/crba.py``), O(n^2) with a small constant and symmetric by
+    construction.  ``method='newton_euler'``: column k is the
     Newton-Euler torque for qdd = e_k with no velocity and no gravity; n
     recursions, O(n^2) with a larger constant, then averaged with its
     transpose.  The two agree to round-off (within 10 n eps relative in
@@ -353,17 +220,20 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
             D = np.empty((w.n, w.n)) if out is None else out
             if _crba(model.packed, q, w.ws, D) < 0:
                 return D
-        except (TypeError, AttributeError):
+        except Refused:
             pass
+        except AttributeError:
+            foreign_workspace(model, ws)
+            raise
     elif method != 'newton_euler':
-        raise _bad_method(method)
-    ws = _workspace(model, ws)
+        raise bad_method(method)
+    ws = workspace(model, ws)
     n = ws.n
-    q = _vector('q', q, n)
-    D = _out(out, (n, n))
-    bad = _mass(model.packed, q, method == 'crba', ws.ws, ws.scratch, D)
-    if bad >= 0:
-        _raise_status(bad, (q,))
+    q = vector('q', q, n)
+    D = out_array(out, (n, n))
+    code = _mass(model.packed, q, method == 'crba', ws.ws, ws.scratch, D)
+    if code >= 0:
+        raise status_error(code, (q,))
     return D
 
 
@@ -390,32 +260,36 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
 
     ``method='composite'`` (the default): two O(n) passes over composite
     bodies and 18 multiply-adds per entry, O(n^2) with a small constant
-    (``_kernels.coriolis_matrix_composite``).  ``method='newton_euler'``:
-    column k from one recursion with the reference velocity e_k (see
-    ``_kernels``), n recursions.  The two agree to round-off.
+    (``kernels/coriolis.py``).  ``method='newton_euler'``: column k from
+    one recursion with the reference velocity e_k (see
+    ``kernels/newton_euler.py``), n recursions.  The two agree to
+    round-off.
     """
     if method == 'composite':
         composite = True
     elif method == 'newton_euler':
         composite = False
     else:
-        raise _bad_method(method, CORIOLIS_METHODS)
+        raise bad_method(method, CORIOLIS_METHODS)
     w = model.default_workspace if ws is None else ws
     try:
         C = np.empty((w.n, w.n)) if out is None else out
         if _coriolis(model.packed, q, qd, composite, w.ws, w.cw, w.scratch,
                      C) < 0:
             return C
-    except (TypeError, AttributeError):
+    except Refused:
         pass
-    ws = _workspace(model, ws)
+    except AttributeError:
+        foreign_workspace(model, ws)    # raises for a ws of another type
+        raise
+    ws = workspace(model, ws)
     n = ws.n
-    q, qd = _vector('q', q, n), _vector('qd', qd, n)
-    C = _out(out, (n, n))
-    bad = _coriolis(model.packed, q, qd, composite, ws.ws, ws.cw, ws.scratch,
-                    C)
-    if bad >= 0:
-        _raise_status(bad, (q, qd))
+    q, qd = vector('q', q, n), vector('qd', qd, n)
+    C = out_array(out, (n, n))
+    code = _coriolis(model.packed, q, qd, composite, ws.ws, ws.cw,
+                     ws.scratch, C)
+    if code >= 0:
+        raise status_error(code, (q, qd))
     return C
 
 
@@ -427,16 +301,16 @@ def jacobian(model, q, frame='base', *, ws=None, out=None):
     ``[v; w] = J(q) qd``, in base-frame axes (``frame='base'``) or
     end-effector axes (``frame='end_effector'``).  Cost: O(n).
     """
-    ws = model.default_workspace if ws is None else _workspace(model, ws)
-    if frame not in _WRENCH_FRAMES:
+    ws = workspace(model, ws)
+    if frame not in WRENCH_FRAMES:
         raise DynamicsInputError(
             f"frame must be 'base' or 'end_effector', got {frame!r}")
     n = ws.n
-    q = _vector('q', q, n)
-    J = _out(out, (6, n))
-    bad = _jac(model.packed, q, frame == 'end_effector', ws.ws, ws.frames, J)
-    if bad >= 0:
-        _raise_status(bad, (q,))
+    q = vector('q', q, n)
+    J = out_array(out, (6, n))
+    code = _jac(model.packed, q, frame == 'end_effector', ws.ws, ws.frames, J)
+    if code >= 0:
+        raise status_error(code, (q,))
     return J
 
 
@@ -448,20 +322,20 @@ def wrench_torques(model, q, wrench, wrench_frame='base', *, ws=None):
     applies the same wrench as f_{n+1}, tau_{n+1} in its backward pass, and
     the two agree to round-off.
     """
-    F = _vector('wrench', wrench, 6)
+    F = vector('wrench', wrench, 6)
     i = K.first_nonfinite(F)
     if i >= 0:
-        _raise_nonfinite(3000 + i, (None, None, None, F))
+        raise status_error(3 * K.NONFINITE + i, (None, None, None, F))
     J = jacobian(model, q, wrench_frame, ws=ws)
     return J.T @ F
 
 
 def _poses_array(model, q, ws):
-    ws = model.default_workspace if ws is None else _workspace(model, ws)
-    q = _vector('q', q, ws.n)
-    bad = _poses(model.packed, q, ws.ws, ws.frames)
-    if bad >= 0:
-        _raise_status(bad, (q,))
+    ws = workspace(model, ws)
+    q = vector('q', q, ws.n)
+    code = _poses(model.packed, q, ws.ws, ws.frames)
+    if code >= 0:
+        raise status_error(code, (q,))
     return ws.frames
 
 
@@ -495,16 +369,17 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
     Joint accelerations: solve D(q) qdd = tau - C qd - g - J^T F_e.
 
     ``method='aba'`` (the default): the articulated-body algorithm, O(n),
-    without forming D (``_kernels.articulated_body``).
+    without forming D (``kernels/aba.py``).
     ``method='cholesky'``: D by CRBA and a Cholesky factorisation of it
     (never an explicit inverse), O(n^3).  The two agree to round-off
     (relative to the conditioning of D).  Either raises
     :class:`NotPositiveDefiniteError` naming the first joint at which D
     is not positive definite (a joint that moves no mass or inertia).
     """
-    flags = (1 if gravity else 0) | (2 if velocity_products else 0)
+    flags = 3 if gravity is True and velocity_products is True else (
+        (1 if gravity else 0) | (2 if velocity_products else 0))
     if wrench is not None:
-        flags |= _wrench_mode(wrench, wrench_frame) << K.WRENCH_SHIFT
+        flags |= wrench_mode(wrench, wrench_frame) << 2
     if method == 'aba':
         w = model.default_workspace if ws is None else ws
         try:
@@ -513,24 +388,40 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                     w.zero_wrench if wrench is None else wrench, flags,
                     w.ws, w.aw, qdd) < 0:
                 return qdd
-        except (TypeError, AttributeError):
+        except Refused:
             pass
+        except AttributeError:
+            foreign_workspace(model, ws)
+            raise
         return _aba_converted(model, ws, q, qd, tau, wrench, flags, out)
     if method != 'cholesky':
-        raise _bad_method(method, FORWARD_DYNAMICS_METHODS)
-    ws = _workspace(model, ws)
+        raise bad_method(method, FORWARD_DYNAMICS_METHODS)
+    ws = workspace(model, ws)
     n = ws.n
-    q, qd, tau = (_vector('q', q, n), _vector('qd', qd, n),
-                  _vector('tau', tau, n))
+    q, qd, tau = vector('q', q, n), vector('qd', qd, n), vector('tau', tau, n)
     i = K.first_nonfinite(tau)
     if i >= 0:
-        _raise_nonfinite(2000 + i, (q, qd, tau), names=_FD_INPUTS)
-    qdd = _out(out, (n,))
+        raise status_error(2 * K.NONFINITE + i, (q, qd, tau), FD_INPUTS)
+    qdd = out_array(out, (n,))
     bias = inverse_dynamics(model, q, qd, None, wrench, wrench_frame,
                             gravity=gravity,
                             velocity_products=velocity_products, ws=ws)
     return solve_mass_matrix(model, q, mass_matrix(model, q, ws=ws),
                              tau - bias, ws=ws, out=qdd)
+
+
+def _aba_converted(model, ws, q, qd, tau, wrench, flags, out):
+    """Call the articulated-body entry again, arguments converted once."""
+    ws = workspace(model, ws)
+    n = ws.n
+    q, qd, tau = vector('q', q, n), vector('qd', qd, n), vector('tau', tau, n)
+    w = ws.zero_wrench if wrench is None else vector('wrench', wrench, 6)
+    qdd = out_array(out, (n,))
+    code = _aba(model.packed, q, qd, tau, w, flags, ws.ws, ws.aw, qdd)
+    if code >= 0:
+        raise status_error(code, (q, qd, tau, w), FD_INPUTS, model=model,
+                           q=q, ws=ws)
+    return qdd
 
 
 def solve_mass_matrix(model, q, D, rhs, *, ws=None, out=None):
@@ -542,154 +433,10 @@ def solve_mass_matrix(model, q, D, rhs, *, ws=None, out=None):
     positive definite.  The Cholesky path of :func:`forward_dynamics` and
     the simulator's forward dynamics.
     """
-    ws = _workspace(model, ws)
-    x = _out(out, (ws.n,))
+    ws = workspace(model, ws)
+    x = out_array(out, (ws.n,))
     bad = K.cholesky_solve(D, np.ascontiguousarray(rhs, dtype=np.float64),
                            ws.chol, x)
     if bad >= 0:
-        raise _not_positive_definite(model, q, bad, ws)
+        raise not_positive_definite(model, q, bad, ws)
     return x
-
-
-def _aba_converted(model, ws, q, qd, tau, wrench, flags, out):
-    """Call the articulated-body kernel again, arguments converted."""
-    ws = _workspace(model, ws)
-    n = ws.n
-    q, qd, tau = (_vector('q', q, n), _vector('qd', qd, n),
-                  _vector('tau', tau, n))
-    w = ws.zero_wrench if wrench is None else _vector('wrench', wrench, 6)
-    qdd = _out(out, (n,))
-    bad = _aba(model.packed, q, qd, tau, w, flags, ws.ws, ws.aw, qdd)
-    if bad >= K.SINGULAR:
-        raise _not_positive_definite(model, q, bad - K.SINGULAR, ws)
-    if bad >= 0:
-        _raise_status(bad, (q, qd, tau, w), _FD_INPUTS)
-    return qdd
-
-
-# ---------------------------------------------------------------------------
-# batches of states
-
-def _matrix(name, X, cols, rows=None):
-    try:
-        X = np.ascontiguousarray(X, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise DynamicsInputError(f'{name} must be numeric: {exc}') from None
-    if X.ndim != 2 or X.shape[1] != cols or (rows is not None
-                                             and X.shape[0] != rows):
-        want = f'({rows if rows is not None else "m"}, {cols})'
-        raise DynamicsInputError(
-            f'{name} must have shape {want}, got {X.shape}')
-    if not X.flags.writeable:
-        X = X.copy()
-    bad = np.argwhere(~np.isfinite(X))
-    if bad.size:
-        r, c = bad[0]
-        raise DynamicsInputError(
-            f'{name}[{r}, {c}] is {float(X[r, c])!r}; every entry must be '
-            f'finite')
-    return X
-
-
-def _batch_states(model, ws, Q, QD, name_qd='QD'):
-    ws = model.default_workspace if ws is None else _workspace(model, ws)
-    Q = _matrix('Q', Q, ws.n)
-    QD = None if QD is None else _matrix(name_qd, QD, ws.n, Q.shape[0])
-    return ws, Q, QD
-
-
-def _batch_wrenches(W, wrench_frame, m):
-    if W is None:
-        return np.zeros((m, 6)), K.WRENCH_NONE
-    return _matrix('W', W, 6, m), _wrench_mode(W, wrench_frame)
-
-
-def _batch_failed(row, code, label):
-    if code == K.OVERFLOW:
-        raise DynamicsInputError(
-            f'the result for row {row} overflows float64 (inputs too '
-            f'large); nothing is returned')
-    raise DynamicsInputError(f'{label} failed at row {row} (code {code})')
-
-
-def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
-                           wrench_frame='base', *, gravity=True,
-                           velocity_products=True, ws=None, out=None):
-    """
-    :func:`inverse_dynamics` for each row of (m, n) arrays of states.
-
-    ``W`` is an (m, 6) array of wrenches or None.  Returns (m, n).  One
-    compiled loop: no Python work per state.
-    """
-    ws, Q, QD = _batch_states(model, ws, Q, QD)
-    m = Q.shape[0]
-    QD = np.zeros_like(Q) if QD is None else QD
-    QDD = np.zeros_like(Q) if QDD is None else _matrix('QDD', QDD, ws.n, m)
-    W, mode = _batch_wrenches(W, wrench_frame, m)
-    TAU = _out(out, Q.shape)
-    row = K.run_inverse_dynamics_batch(
-        model.packed, Q, QD, QDD, W, _flags(gravity, velocity_products, mode),
-        ws.ws, TAU, ws.status)
-    if row >= 0:
-        _batch_failed(row, ws.status[0], 'inverse dynamics')
-    return TAU
-
-
-def gravity_torques_batch(model, Q, *, ws=None, out=None):
-    """:func:`gravity_torques` for each row of an (m, n) array; (m, n)."""
-    ws, Q, _ = _batch_states(model, ws, Q, None)
-    G = _out(out, Q.shape)
-    row = K.run_gravity_torques_batch(model.packed, Q, ws.ws, G, ws.status)
-    if row >= 0:
-        _batch_failed(row, ws.status[0], 'the gravity torques')
-    return G
-
-
-def mass_matrix_batch(model, Q, *, ws=None, out=None):
-    """:func:`mass_matrix` (CRBA) for each row of Q; returns (m, n, n)."""
-    ws, Q, _ = _batch_states(model, ws, Q, None)
-    DD = _out(out, (Q.shape[0], ws.n, ws.n))
-    row = K.run_mass_matrix_batch(model.packed, Q, ws.ws, DD, ws.status)
-    if row >= 0:
-        _batch_failed(row, ws.status[0], 'the mass matrix')
-    return DD
-
-
-def coriolis_matrix_batch(model, Q, QD, *, ws=None, out=None):
-    """:func:`coriolis_matrix` (composite) for each row; (m, n, n)."""
-    ws, Q, QD = _batch_states(model, ws, Q, QD)
-    QD = np.zeros_like(Q) if QD is None else QD
-    CC = _out(out, (Q.shape[0], ws.n, ws.n))
-    row = K.run_coriolis_matrix_batch(model.packed, Q, QD, ws.ws, ws.cw, CC,
-                                      ws.status)
-    if row >= 0:
-        _batch_failed(row, ws.status[0], 'the Coriolis matrix')
-    return CC
-
-
-def forward_dynamics_batch(model, Q, QD, TAU, W=None, wrench_frame='base', *,
-                           gravity=True, velocity_products=True, ws=None,
-                           out=None):
-    """
-    :func:`forward_dynamics` (articulated-body) for each row; (m, n).
-
-    Raises :class:`NotPositiveDefiniteError` for the first row where D is
-    singular, naming the row and the joint.
-    """
-    ws, Q, QD = _batch_states(model, ws, Q, QD)
-    m = Q.shape[0]
-    QD = np.zeros_like(Q) if QD is None else QD
-    TAU = _matrix('TAU', TAU, ws.n, m)
-    W, mode = _batch_wrenches(W, wrench_frame, m)
-    QDD = _out(out, Q.shape)
-    row = K.run_forward_dynamics_batch(
-        model.packed, Q, QD, TAU, W, _flags(gravity, velocity_products, mode),
-        ws.ws, ws.aw, QDD, ws.status)
-    if row >= 0:
-        code = int(ws.status[0])
-        if code >= K.SINGULAR:
-            err = _not_positive_definite(model, Q[row], code - K.SINGULAR,
-                                         ws)
-            raise NotPositiveDefiniteError(f'row {row}: {err}', err.joint)
-        _batch_failed(row, code, 'forward dynamics')
-    return QDD

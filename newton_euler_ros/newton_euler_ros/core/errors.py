@@ -50,3 +50,7 @@ class NotPositiveDefiniteError(NewtonEulerError, ArithmeticError):
     def __init__(self, message, joint):
         super().__init__(message)
         self.joint = joint
+
+
+class RobotFileWarning(UserWarning):
+    """A robot file is accepted but something in it is suspicious."""

@@ -15,7 +15,7 @@
 """
 The same dynamics computed in single precision (float32) throughout.
 
-:class:`Float32Dynamics` runs the very kernels of ``_kernels`` on float32
+:class:`Float32Dynamics` runs the very kernels of ``kernels`` on float32
 copies of a model's arrays.  The kernels take every constant from the
 model's constants row, so numba compiles a float32 specialization in
 which every intermediate is a float32 (the test suite checks numba's type
@@ -54,14 +54,15 @@ Examples
 dtype('float32')
 
 """
-import math
 
 import numpy as np
 
-from . import _kernels as K
-from .dynamics import (_bad_method, _FD_INPUTS, _INPUTS,
-                       _not_positive_definite, _raise_nonfinite, _vector,
-                       _wrench_mode, CORIOLIS_METHODS)
+from . import kernels as K
+from .calling import (bad_method as _bad_method, CORIOLIS_METHODS,
+                      FD_INPUTS as _FD_INPUTS, INPUTS as _INPUTS,
+                      not_positive_definite as _not_positive_definite,
+                      status_error, vector as _vector,
+                      wrench_mode as _wrench_mode)
 from .errors import DynamicsInputError
 from .workspace import Workspace
 
@@ -87,16 +88,7 @@ def _out(out):
 
 def _raise(code, rounded, given, names=_INPUTS):
     """Raise for a bad input, naming float32 overflow as such."""
-    if code != K.OVERFLOW:
-        arg, i = divmod(code, 1000)
-        if given[arg] is not None:
-            value = float(np.ravel(np.asarray(given[arg],
-                                              dtype=np.float64))[i])
-            if math.isfinite(value):
-                raise DynamicsInputError(
-                    f'{names[arg]}[{i}] is {value!r}, outside the '
-                    f'float32 range (|x| <= {_F32_MAX:.8g})')
-    _raise_nonfinite(code, rounded, 'float32', names)
+    raise status_error(code, rounded, names, 'float32', given=given)
 
 
 class Float32Dynamics:
@@ -194,7 +186,7 @@ class Float32Dynamics:
             raise _bad_method(method)
         if K.run_mass_matrix(self.packed, q32, method == 'crba', self._ws.ws,
                              self._ws.scratch, D) >= 0:
-            _raise_nonfinite(K.OVERFLOW, (), 'float32')
+            raise status_error(K.OVERFLOW, precision='float32')
         return D
 
     def coriolis_matrix(self, q, qd, *, method='composite', out=None):
@@ -218,7 +210,7 @@ class Float32Dynamics:
         if K.run_coriolis_matrix(self.packed, q32, qd32, method == 'composite',
                                  self._ws.ws, self._ws.cw, self._ws.scratch,
                                  C) >= 0:
-            _raise_nonfinite(K.OVERFLOW, (), 'float32')
+            raise status_error(K.OVERFLOW, precision='float32')
         return C
 
     def forward_dynamics(self, q, qd, tau, wrench=None, wrench_frame='base',

@@ -15,8 +15,8 @@
 """
 The same Newton-Euler recursion in high precision (mpmath), as a reference.
 
-The source of ``_kernels`` is executed a second time with ``njit``
-replaced by the identity and ``math`` by mpmath, over numpy object arrays
+The kernel files (``kernels``) are executed a second time with ``njit``
+replaced by the identity and ``math`` by mpmath (``kernels.load_copy``), over numpy object arrays
 of ``mpf`` numbers: one implementation of the recursion, evaluated at 50
 significant digits (by default) from the exact float64 inputs.  The
 model is compiled into kernel frames at that precision too (the same
@@ -28,19 +28,13 @@ float64 base/tool matrices) are taken as exact.
 Slow (milliseconds per call): for measuring the error of the float64 and
 float32 paths, never for control.
 """
-import os
-import types
-
 import mpmath
 import numpy as np
 
-from . import _kernels as K
-from .dynamics import (_bad_method, CORIOLIS_METHODS,
-                       FORWARD_DYNAMICS_METHODS, MASS_MATRIX_METHODS)
+from . import kernels as K
+from .calling import (bad_method as _bad_method, CORIOLIS_METHODS,
+                      FORWARD_DYNAMICS_METHODS, MASS_MATRIX_METHODS)
 from .model import compile_arrays
-
-_SOURCE = os.path.join(os.path.dirname(os.path.abspath(__file__)),
-                       '_kernels.py')
 
 
 class _MpMath:
@@ -56,18 +50,12 @@ class _MpMath:
         return bool(mpmath.isfinite(x))
 
 
-def _load_kernels():
-    module = types.ModuleType('newton_euler_ros.core._kernels_mp')
-    module.__dict__['__njit_override__'] = lambda f=None, **kw: (
-        f if f is not None else (lambda g: g))
-    with open(_SOURCE, encoding='utf-8') as fh:
-        code = compile(fh.read(), _SOURCE, 'exec')
-    exec(code, module.__dict__)  # noqa: S102 - our own source file
-    module.__dict__['math'] = _MpMath
-    return module
+def _identity(f=None, **options):
+    """``njit`` replaced: the kernels run as plain Python."""
+    return f if f is not None else (lambda g: g)
 
 
-_MP = _load_kernels()
+_MP = K.load_copy('mp', _identity, _MpMath)
 
 
 def _mp_array(x):
@@ -144,8 +132,8 @@ class HighPrecisionModel:
         n = self.model.n
         _MP.joint_trig(self.links, self.frames, q, ws)
         scratch = np.full((3, n), mpmath.mpf(0), dtype=object)
-        _MP._unit_columns(self.links, self.frames, qd, coriolis, ws,
-                          scratch, M)
+        _MP.unit_columns(self.links, self.frames, qd, coriolis, ws, scratch,
+                         M)
         return M
 
     def coriolis_matrix(self, q, qd, method='newton_euler'):

@@ -17,7 +17,7 @@ The constant robot model: a serial chain of revolute and prismatic joints.
 
 A :class:`RobotModel` is immutable after construction (its arrays are
 read-only).  Per-call scratch memory lives in a separate
-:class:`~newton_euler_ros.core.dynamics.Workspace`.
+:class:`~newton_euler_ros.core.workspace.Workspace`.
 
 One joint model for every source.  Joint j carries link frame j-1 to link
 frame j as
@@ -65,7 +65,9 @@ import math
 
 import numpy as np
 
-from . import _kernels as K
+from . import kernels as K
+from .inertia import inertia_matrix, merge_bodies  # noqa: F401 (re-export)
+from .workspace import Workspace
 
 REVOLUTE = 'revolute'
 PRISMATIC = 'prismatic'
@@ -145,7 +147,6 @@ def _transpose(A):
 def _elementary(op, args, m):
     """(R, p) of one operation, in the number type of ``m``."""
     R, p = _identity(m)
-    z, o = m.num(0.0), m.num(1.0)
     if op in ('tx', 'ty', 'tz'):
         p['xyz'.index(op[1])] = m.num(args[0])
     elif op in ('rx', 'ry', 'rz'):
@@ -163,7 +164,6 @@ def _elementary(op, args, m):
         p = [m.num(x) for x in args[9:]]
     else:
         raise ValueError(f'unknown transform operation {op!r}')
-    del z, o
     return R, p
 
 
@@ -305,7 +305,7 @@ class RobotModel:
     info : dict of source details (e.g. URDF link names); not dynamics
     links_array, frames_array : read-only copies for the kernels
     packed : both in one read-only array, as the kernels' entry points
-        take them (``_kernels.pack``)
+        take them (``kernels.pack``)
 
     """
 
@@ -359,7 +359,6 @@ class RobotModel:
         Created on first use and shared by all such calls on this model:
         not thread-safe (give each thread its own ``Workspace(model)``).
         """
-        from .workspace import Workspace
         return Workspace(self)
 
     @property
@@ -489,12 +488,6 @@ def make_chain(name, joint_names, joint_types, joint_pre, joint_axis,
                   gravity, base, tool, limits, info))
 
 
-def inertia_matrix(ixx, iyy, izz, ixy, iyz, ixz):
-    """Symmetric 3x3 inertia from [Ixx, Iyy, Izz, Ixy, Iyz, Ixz]."""
-    return np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]],
-                    dtype=np.float64)
-
-
 def _tx_rx(a, alpha):
     """Homogeneous Tx(a) Rx(alpha)."""
     ca, sa = math.cos(alpha), math.sin(alpha)
@@ -562,21 +555,12 @@ def with_payload(model, mass, com, inertia):
     """
     if not mass >= 0.0:
         raise ValueError(f'payload mass must be >= 0, got {mass}')
-    R_tool = model.tool[:3, :3]
-    c_p = R_tool @ np.asarray(com, dtype=float) + model.tool[:3, 3]
-    I_p = R_tool @ np.asarray(inertia, dtype=float) @ R_tool.T
-    m_l = model.mass[-1]
-    c_l = model.com[-1]
-    m = m_l + mass
+    m, c, I_new = merge_bodies([
+        (model.mass[-1], model.com[-1], model.inertia[-1], np.eye(3),
+         np.zeros(3)),
+        (mass, com, inertia, model.tool[:3, :3], model.tool[:3, 3])])
     if m == 0.0:
         return model
-    c = (m_l * c_l + mass * c_p) / m
-
-    def shifted(inertia_c, m_b, c_b):
-        d = c_b - c
-        return inertia_c + m_b * (d @ d * np.eye(3) - np.outer(d, d))
-
-    I_new = shifted(model.inertia[-1], m_l, c_l) + shifted(I_p, mass, c_p)
     masses = np.array(model.mass)
     coms = np.array(model.com)
     inertias = np.array(model.inertia)

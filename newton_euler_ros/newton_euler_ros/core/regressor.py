@@ -55,16 +55,16 @@ within 1e-4 of +-1 from |qd| = 5 eps.  ``eps`` is the Coulomb width,
 The kernels work in kernel frames (joint axis on z); ``links[j, L_BODY:]``
 gives the link frame in kernel frame j (see ``model.compile_arrays``).
 This module keeps its kernel to itself and takes only the column and row
-constants from ``_kernels``.
+constants from ``kernels``.
 """
 import math
 
 from numba import njit
 import numpy as np
 
-from ._kernels import (C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, L_P, L_R,
-                       L_TYPE)
 from .errors import DynamicsInputError
+from .kernels import (C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, L_P, L_R,
+                      L_TYPE)
 
 N_INERTIAL = 10            # parameters per link
 N_DRIVE = 4                # drive parameters per joint

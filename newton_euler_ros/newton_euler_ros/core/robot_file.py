@@ -31,9 +31,19 @@ import warnings
 import numpy as np
 import yaml
 
-from .errors import RobotFileError
-from .model import (inertia_matrix, make_model, MODIFIED, pose_matrix,
-                    PRISMATIC, REVOLUTE, STANDARD)
+from .calling import first_singular_pivot
+from .dynamics import mass_matrix
+from .errors import DynamicsInputError, RobotFileError, RobotFileWarning
+from .inertia import (format_moments, inertia_matrix, is_symmetric, Note,
+                      principal_moments, triangle_note)
+from .model import (make_model, MODIFIED, pose_matrix, PRISMATIC, REVOLUTE,
+                    STANDARD)
+from .text import clip_repr as _short, MAX_FILE_BYTES, read_text
+from .urdf import inspect_urdf
+
+__all__ = ['MAX_FILE_BYTES', 'Note', 'RobotFileWarning', 'read_text',
+           'triangle_note', 'bundled_robots', 'inspect_robot', 'load_robot',
+           'robot_from_dict']
 
 TOP_KEYS = {'name', 'description', 'source', 'convention', 'gravity', 'base',
             'tool', 'links'}
@@ -42,36 +52,6 @@ LINK_KEYS = {'name', 'description', 'type', 'a', 'alpha', 'd', 'theta',
 LINK_REQUIRED = ('name', 'type', 'a', 'alpha', 'd', 'mass', 'com', 'inertia')
 LIMIT_KEYS = {'lower', 'upper', 'velocity', 'effort'}
 POSE_KEYS = {'xyz', 'rpy'}
-
-
-class Note(str):
-    """
-    A warning about published data that is accepted as published.
-
-    ``newton-euler check`` and the node's start-up log show notes; the
-    other commands do not repeat them on every use.
-    """
-
-
-def triangle_note(where, eig):
-    """
-    Return a Note when principal moments break the triangle inequality.
-
-    ``eig``: the three principal moments, ascending.  No real body has
-    such moments, but published models do (the Puma 560's link 1): they
-    are accepted as published, with this note.
-    """
-    tol = 1e-9 * max(eig[2], 1e-300)
-    if eig[0] + eig[1] < eig[2] - tol:
-        return Note(f'{where}: principal moments {eig[0]:.6g}, '
-                    f'{eig[1]:.6g}, {eig[2]:.6g} break the triangle '
-                    f'inequality (no real body has them); accepted as '
-                    f'published')
-    return None
-
-
-class RobotFileWarning(UserWarning):
-    """A robot file is accepted but something in it is suspicious."""
 
 
 def bundled_dirs():
@@ -112,23 +92,7 @@ def resolve_robot_path(name_or_path):
         f'(bundled: {", ".join(bundled_robots()) or "none found"})')
 
 
-MAX_FILE_BYTES = 1024 * 1024     # robot and scene files are a few kB
 MAX_DEPTH = 32                   # they nest 4 levels deep
-
-
-class _Clipped(str):
-    """A clipped repr that prints as itself under ``!r`` and ``str``."""
-
-    def __repr__(self):
-        return str(self)
-
-
-def _short(value, limit=200):
-    """Return value, or its repr clipped to ``limit`` characters."""
-    text = repr(value)
-    if len(text) <= limit:
-        return value
-    return _Clipped(text[:limit] + '...')
 
 
 class _SafeLoader(yaml.SafeLoader):
@@ -173,39 +137,6 @@ def _construct_mapping(loader, node, deep=False):
 
 _SafeLoader.add_constructor(
     yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
-
-
-def read_text(path, max_bytes=MAX_FILE_BYTES, what='file'):
-    """
-    Read a UTF-8 text file; every failure is a one-line RobotFileError.
-
-    Refuses a directory, a file larger than ``max_bytes`` (without reading
-    it), an empty file and bytes that are not UTF-8.
-    """
-    label = _short(path)
-    if os.path.isdir(path):
-        raise RobotFileError(f'{label}: is a directory, not a {what}')
-    try:
-        size = os.path.getsize(path)
-        if size > max_bytes:
-            raise RobotFileError(f'{label}: {size} bytes, more than the '
-                                 f'{max_bytes} accepted for a {what}')
-        with open(path, 'rb') as fh:
-            data = fh.read(max_bytes + 1)
-    except OSError as exc:
-        raise RobotFileError(f'{label}: cannot read: {exc.strerror}') \
-            from None
-    if len(data) > max_bytes:
-        raise RobotFileError(f'{label}: more than the {max_bytes} bytes '
-                             f'accepted for a {what}')
-    try:
-        text = data.decode('utf-8')
-    except UnicodeDecodeError as exc:
-        raise RobotFileError(f'{label}: not UTF-8 text (byte {exc.start}); '
-                             f'is it a {what}?') from None
-    if not text.strip():
-        raise RobotFileError(f'{label}: the file is empty')
-    return text
 
 
 def read_yaml(path):
@@ -311,18 +242,16 @@ def _inertia(value, where):
             isinstance(r, (list, tuple)) for r in value):
         rows = [to_vector(r, 3, f'{where}[{i}]') for i, r in enumerate(value)]
         inertia = np.array(rows)
-        scale = max(np.abs(inertia).max(), 1e-300)
-        if np.abs(inertia - inertia.T).max() > 1e-12 * scale:
+        if not is_symmetric(inertia):
             raise RobotFileError(f'{where}: must be symmetric, got {rows}')
         inertia = 0.5 * (inertia + inertia.T)
     else:
         inertia = inertia_matrix(*to_vector(value, 6, where))
-    eig = np.linalg.eigvalsh(inertia)
-    scale = max(np.abs(inertia).max(), 1e-300)
-    if eig[0] < -1e-12 * scale:
+    eig, valid = principal_moments(inertia)
+    if not valid:
         raise RobotFileError(
             f'{where}: must be positive semidefinite (principal moments '
-            f'{", ".join(f"{e:.6g}" for e in eig)})')
+            f'{format_moments(eig)})')
     return inertia, eig
 
 
@@ -425,8 +354,6 @@ def singular_joint_warning(model, origin, samples=3, seed=0):
     Tested at a few random configurations (singular at all of them, not
     at an isolated pose).
     """
-    from .dynamics import mass_matrix
-    from .errors import DynamicsInputError
     rng = np.random.default_rng(seed)
     joints = set()
     for _ in range(samples):
@@ -435,17 +362,7 @@ def singular_joint_warning(model, origin, samples=3, seed=0):
             D = mass_matrix(model, q)
         except DynamicsInputError:
             return None
-        scale = max(float(np.abs(np.diag(D)).max()), 1e-300)
-        L = np.zeros_like(D)
-        bad = None
-        for i in range(model.n):    # Cholesky, noting the first bad pivot
-            pivot = D[i, i] - L[i, :i] @ L[i, :i]
-            if not pivot > 1e-12 * scale:
-                bad = i
-                break
-            L[i, i] = math.sqrt(pivot)
-            for k in range(i + 1, model.n):
-                L[k, i] = (D[k, i] - L[k, :i] @ L[i, :i]) / L[i, i]
+        bad = first_singular_pivot(D)
         if bad is None:
             return None
         joints.add(bad)
@@ -471,7 +388,6 @@ def inspect_robot(name_or_path, base=None, tip=None):
     bundled name, for which ``base`` and ``tip`` must be None.
     """
     if is_urdf(name_or_path):
-        from .urdf import inspect_urdf
         model, found, _ = inspect_urdf(name_or_path, base=base, tip=tip)
         path = str(name_or_path)
     else:

@@ -25,7 +25,7 @@ What a URDF model means here (see the README, "Robots from URDF"):
 - ``fixed`` joints on the chain are merged: their origins are composed
   into the next moving joint's placement (or into the tool, after the
   last one), and the links they carry are combined with the moving link
-  by the parallel-axis theorem.
+  by the parallel-axis theorem (``inertia.merge_bodies``).
 - Off-chain subtrees (gripper fingers, a second arm, a head) are lumped
   rigidly into the chain link they hang from, at their joints' zero
   position (a ``mimic`` joint at its offset), with one warning naming
@@ -37,26 +37,30 @@ What a URDF model means here (see the README, "Robots from URDF"):
 - The end effector is the tip link's frame; gravity is [0, 0, -9.81] in
   the base link's axes unless given.
 
-Parsing.  URDF text arrives from the network (the ``robot_description``
-topic), so it is parsed with ``defusedxml``: no DTDs, no entity
-declarations (so no entity expansion bombs), no external entities or
-network access; the text is capped at :data:`MAX_BYTES` and the document
-at :data:`MAX_ELEMENTS` links plus joints.  Meshes and visuals are never
-read.  Every error is a :class:`~newton_euler_ros.core.errors.RobotFileError`
-naming the source (the file, or ``robot_description``), the element and
-the attribute.
+Parsing.  URDF text arrives from the network (``robot_description``),
+so ``defusedxml`` parses it: no DTDs, entity declarations or external
+entities; text capped at :data:`MAX_BYTES`, documents at
+:data:`MAX_ELEMENTS` links plus joints; meshes never read.  Every error is
+a :class:`~newton_euler_ros.core.errors.RobotFileError` naming the source
+(the file, or ``robot_description``), the element and the attribute.
+Writing: :mod:`~newton_euler_ros.core.urdf_writer`.
 """
-import difflib
 import math
 import os
+import warnings
 import xml.etree.ElementTree as ET  # noqa: N817 (only for ParseError)
 
 import defusedxml
 import defusedxml.ElementTree as DET
 import numpy as np
 
-from .errors import RobotFileError
-from .model import make_chain, PRISMATIC, REVOLUTE, rpy_matrix
+from .drives import read_drives
+from .errors import RobotFileError, RobotFileWarning
+from .inertia import format_moments, Note, principal_moments, triangle_note
+from .model import make_chain, pose_matrix, PRISMATIC, REVOLUTE, rpy_matrix
+from .text import clip, read_text
+from .urdf_tree import attached, chain_ends, combine
+from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
 
 MAX_BYTES = 16 * 1024 * 1024
 MAX_ELEMENTS = 20000
@@ -68,8 +72,7 @@ JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'fixed', 'floating',
 
 
 def _short(text, limit=MAX_NAME):
-    text = str(text)
-    return text if len(text) <= limit else text[:limit] + '...'
+    return clip(text, limit)
 
 
 class _Source:
@@ -98,7 +101,6 @@ def read_urdf_text(text_or_path, label=None):
                 f'{label}: {len(text)} characters, more than the '
                 f'{MAX_BYTES} accepted')
         return text, label
-    from .robot_file import read_text
     return read_text(text, MAX_BYTES, 'URDF file'), label or \
         os.path.basename(text)
 
@@ -181,28 +183,6 @@ def _origin_ops(xyz, rpy):
     return ops
 
 
-def _transform(xyz, rpy):
-    T = np.eye(4)
-    T[:3, :3] = rpy_matrix(*rpy)
-    T[:3, 3] = xyz
-    return T
-
-
-def _axis_motion(kind, axis, q):
-    """4x4 of a joint's own motion by q (a locked off-chain joint)."""
-    T = np.eye(4)
-    if q == 0.0:
-        return T
-    if kind in ('revolute', 'continuous'):
-        k = np.asarray(axis)
-        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]],
-                      [-k[1], k[0], 0.0]])
-        T[:3, :3] = np.eye(3) + math.sin(q) * K + (1 - math.cos(q)) * K @ K
-    elif kind == 'prismatic':
-        T[:3, 3] = np.asarray(axis) * q
-    return T
-
-
 class _Link:
     def __init__(self, name):
         self.name = name
@@ -228,7 +208,7 @@ class _Joint:
 
     @property
     def origin(self):
-        return _transform(self.xyz, self.rpy)
+        return pose_matrix(self.xyz, self.rpy)
 
 
 def _name(el, what, src, index):
@@ -264,12 +244,10 @@ def _read_inertial(link, el, src):
     inertia = np.array([[vals['ixx'], vals['ixy'], vals['ixz']],
                         [vals['ixy'], vals['iyy'], vals['iyz']],
                         [vals['ixz'], vals['iyz'], vals['izz']]])
-    eig = np.linalg.eigvalsh(inertia)
-    scale = max(abs(eig).max(), 1e-300)
-    if eig[0] < -1e-9 * scale:
+    eig, valid = principal_moments(inertia)
+    if not valid:
         raise src.error(f'{where}<inertia>', 'not positive semi-definite '
-                        f'(principal moments {eig[0]:.6g}, {eig[1]:.6g}, '
-                        f'{eig[2]:.6g})')
+                        f'(principal moments {format_moments(eig)})')
     R = rpy_matrix(*rpy)
     link.mass = mass
     link.com = np.array(xyz)
@@ -391,73 +369,6 @@ def parse_urdf(text, label='robot_description'):
     return name, roots[0], links, joints
 
 
-def _path(links, joints, base, tip):
-    """Joint names from base down to tip, or None if base is no ancestor."""
-    path = []
-    lname = tip
-    while lname != base:
-        jname = links[lname].parent_joint
-        if jname is None:
-            return None
-        path.append(jname)
-        lname = joints[jname].parent
-    return path[::-1]
-
-
-def _leaves_below(links, joints, base):
-    out = []
-    stack = [base]
-    while stack:
-        lname = stack.pop()
-        kids = links[lname].child_joints
-        if not kids:
-            out.append(lname)
-        stack.extend(joints[j].child for j in kids)
-    return sorted(out)
-
-
-def _lumped(links, joints, start, stop_joints, pose=np.eye(4)):
-    """
-    Every link rigidly attached to ``start``, with its pose in start's frame.
-
-    Follows every joint except those in ``stop_joints`` (the chain's next
-    moving joint); off-chain moving joints are taken at zero (mimic joints
-    at their offset).  Returns [(link name, 4x4 pose, via joint or None)].
-    """
-    out = [(start, pose, None)]
-    stack = [(start, pose)]
-    while stack:
-        lname, T = stack.pop()
-        for jname in links[lname].child_joints:
-            if jname in stop_joints:
-                continue
-            joint = joints[jname]
-            q = joint.mimic[2] if joint.mimic else 0.0
-            Tc = T @ joint.origin @ _axis_motion(joint.kind, joint.axis, q)
-            out.append((joint.child, Tc, jname))
-            stack.append((joint.child, Tc))
-    return out
-
-
-def _combine(parts, links):
-    """Mass, centre of mass and inertia (about it) of rigidly joined links."""
-    mass = 0.0
-    first = np.zeros(3)
-    for lname, T, _ in parts:
-        lk = links[lname]
-        mass += lk.mass
-        first += lk.mass * (T[:3, :3] @ lk.com + T[:3, 3])
-    com = first / mass if mass > 0.0 else np.zeros(3)
-    inertia = np.zeros((3, 3))
-    for lname, T, _ in parts:
-        lk = links[lname]
-        R = T[:3, :3]
-        c = R @ lk.com + T[:3, 3] - com
-        inertia += R @ lk.inertia @ R.T + lk.mass * (
-            (c @ c) * np.eye(3) - np.outer(c, c))
-    return mass, com, 0.5 * (inertia + inertia.T)
-
-
 def urdf_model(text, label='robot_description', base=None, tip=None,
                gravity=(0.0, 0.0, -9.81)):
     """
@@ -467,31 +378,9 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     """
-    from .drives import read_drives
-    from .robot_file import triangle_note
     name, root, links, joints = parse_urdf(text, label)
     found = []
-    base = root if base is None else base
-    for role, lname in (('base', base), ('tip', tip)):
-        if lname is not None and lname not in links:
-            close = difflib.get_close_matches(str(lname), list(links), n=3,
-                                              cutoff=0.5)
-            hint = (' (closest: ' + ', '.join(map(repr, close)) + ')'
-                    if close else
-                    f' (links: {_short(", ".join(links), 300)})')
-            raise RobotFileError(f'{label}: {role} link {_short(lname)!r} is '
-                                 f'not in the URDF{hint}')
-    if tip is None:
-        leaves = _leaves_below(links, joints, base)
-        if len(leaves) != 1:
-            raise RobotFileError(
-                f'{label}: the tree below {base!r} has {len(leaves)} leaves '
-                f'({_short(", ".join(leaves), 400)}); choose the tip link')
-        tip = leaves[0]
-    chain = _path(links, joints, base, tip)
-    if chain is None:
-        raise RobotFileError(f'{label}: base link {base!r} is not an '
-                             f'ancestor of tip link {tip!r}')
+    base, tip, chain = chain_ends(label, links, joints, root, base, tip)
     for jname in chain:
         kind = joints[jname].kind
         if kind in ('floating', 'planar'):
@@ -526,8 +415,8 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     massless = []
     for k, jname in enumerate(moving):
         stop = {moving[k + 1]} if k + 1 < len(moving) else set()
-        parts = _lumped(links, joints, joints[jname].child, stop)
-        m, c, inertia_k = _combine(parts, links)
+        parts = attached(links, joints, joints[jname].child, stop)
+        m, c, inertia_k = combine(parts, links)
         mass.append(m)
         com.append(c)
         inertia.append(inertia_k)
@@ -549,7 +438,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         tip_frames[lname] = tool_inv @ T
     base_frames = {}
     first_stop = {moving[0]}
-    for lname, T, via in _lumped(links, joints, base, first_stop):
+    for lname, T, via in attached(links, joints, base, first_stop):
         if via is None or joints[via].kind == 'fixed':
             base_frames[lname] = T
     # links above the base, when they are joined to it by fixed joints
@@ -633,104 +522,9 @@ def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):
     ``newton-euler check``); errors raise
     :class:`~newton_euler_ros.core.errors.RobotFileError`.
     """
-    import warnings
-    from .robot_file import Note, RobotFileWarning
     model, found, _ = inspect_urdf(text_or_path, base=base, tip=tip,
                                    gravity=gravity)
     for message in found:
         if not isinstance(message, Note):
             warnings.warn(message, RobotFileWarning, stacklevel=2)
     return model
-
-
-# ---------------------------------------------------------------------------
-# writing: any model as URDF (for robot_state_publisher and RViz)
-# ---------------------------------------------------------------------------
-def matrix_rpy(R):
-    """ROS roll, pitch, yaw of a rotation matrix (R = Rz Ry Rx)."""
-    R = np.asarray(R, dtype=float)
-    cp = math.hypot(R[0, 0], R[1, 0])
-    pitch = math.atan2(-R[2, 0], cp)
-    if cp > 1e-12:
-        roll = math.atan2(R[2, 1], R[2, 2])
-        yaw = math.atan2(R[1, 0], R[0, 0])
-    else:   # gimbal lock: put the whole rotation about x into roll
-        roll = math.atan2(-R[1, 2], R[1, 1])
-        yaw = 0.0
-    return roll, pitch, yaw
-
-
-def _fmt(values):
-    return ' '.join(repr(float(v)) for v in values)
-
-
-def _origin_xml(T, indent):
-    xyz = T[:3, 3]
-    rpy = matrix_rpy(T[:3, :3])
-    return f'{indent}<origin xyz="{_fmt(xyz)}" rpy="{_fmt(rpy)}"/>'
-
-
-def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
-    """
-    Return URDF text of a model: links with inertials, joints with limits.
-
-    URDF link k is the frame joint k moves (link frame k-1 . Pre_k . M(q));
-    the model's link frame k sits at Post_k in it, so the inertial origin
-    is Post_k applied to the centre of mass, with Post_k's rotation; joint
-    k's origin is Post_{k-1} Pre_k (the base pose for k = 1).  The end
-    effector is a fixed link ``tool_link``.  Loading the text back gives
-    the same dynamics (the tests check tau, D, C, g and J).
-    """
-    n = model.n
-    link_names = [f'link{k + 1}' for k in range(n)]
-    lines = ['<?xml version="1.0"?>',
-             f'<!-- {model.name}: written by newton-euler urdf from a '
-             f'{model.convention} model; gravity in {base_link} axes: '
-             f'{_fmt(model.gravity)} m/s^2 -->',
-             f'<robot name="{model.name}">',
-             f'  <link name="{base_link}"/>']
-    prev_post = np.asarray(model.base, dtype=float)
-    for k in range(n):
-        post = model.joint_post_matrix(k)
-        origin = prev_post @ model.joint_pre_matrix(k)
-        lim = model.limits[k] if k < len(model.limits) else {}
-        kind = model.joint_types[k]
-        if kind == REVOLUTE and not ('lower' in lim and 'upper' in lim):
-            kind = 'continuous'
-        parent = base_link if k == 0 else link_names[k - 1]
-        inertia = np.asarray(model.inertia[k])
-        com = post[:3, :3] @ model.com[k] + post[:3, 3]
-        inertial_pose = np.eye(4)
-        inertial_pose[:3, :3] = post[:3, :3]
-        inertial_pose[:3, 3] = com
-        lines += [
-            f'  <link name="{link_names[k]}">',
-            '    <inertial>',
-            _origin_xml(inertial_pose, '      '),
-            f'      <mass value="{_fmt([model.mass[k]])}"/>',
-            '      <inertia ' + ' '.join(
-                f'{key}="{_fmt([inertia[i, k]])}"' for key, i, k in (
-                    ('ixx', 0, 0), ('ixy', 0, 1), ('ixz', 0, 2),
-                    ('iyy', 1, 1), ('iyz', 1, 2), ('izz', 2, 2))) + '/>',
-            '    </inertial>',
-            '  </link>',
-            f'  <joint name="{model.joint_names[k]}" type="{kind}">',
-            f'    <parent link="{parent}"/>',
-            f'    <child link="{link_names[k]}"/>',
-            _origin_xml(origin, '    '),
-            f'    <axis xyz="{_fmt(model.joint_axis[k])}"/>']
-        attrs = [f'{key}="{_fmt([lim[key]])}"' for key in ('lower', 'upper')
-                 if key in lim and kind != 'continuous']
-        attrs += [f'{key}="{_fmt([lim.get(key, 0.0)])}"'
-                  for key in ('effort', 'velocity')]
-        lines += [f'    <limit {" ".join(attrs)}/>', '  </joint>']
-        prev_post = post
-    lines += [f'  <link name="{tool_link}"/>',
-              f'  <joint name="{tool_link}_joint" type="fixed">',
-              f'    <parent link="{link_names[-1]}"/>',
-              f'    <child link="{tool_link}"/>',
-              _origin_xml(prev_post @ np.asarray(model.tool, dtype=float),
-                          '    '),
-              '  </joint>',
-              '</robot>', '']
-    return '\n'.join(lines)

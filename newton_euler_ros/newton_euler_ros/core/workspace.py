@@ -16,7 +16,7 @@
 """Preallocated scratch memory for the kernels of one model size."""
 import numpy as np
 
-from . import _kernels as K
+from . import kernels as K
 
 
 class Workspace:

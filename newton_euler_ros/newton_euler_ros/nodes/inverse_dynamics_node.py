@@ -66,8 +66,7 @@ from ..feedforward import (check_payload, clip, FeedforwardComputer,
                            InputRejected, JointOrder, payload_model,
                            ReferenceTrajectory, rigid_frames, WrenchInput)
 from ..parameters import load_specs
-from ..safety import (effort_bounds, TorqueGuard, velocity_bounds,
-                      wrench_bounds)
+from ..safety import effort_bounds, wrench_bounds
 from ..sim.scene import load_scene
 
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
@@ -217,22 +216,10 @@ class InverseDynamicsNode(Node):
         bounds, sources = effort_bounds(model, override)
         if wrench is None:
             wrench = self._wrench_input(p, model, bounds)
-        ff = FeedforwardComputer(model, order, wrench, reference, scene,
-                                 self.mode)
-        ff.guard = TorqueGuard(order.to_output_order(bounds),
-                               p['limits.action'])
-        ff.bound_sources = [sources[k] for k in order.to_output]
-        ff.velocity_bounds = velocity_bounds(model, p['limits.velocity_factor'],
-                                             p['limits.max_velocity'])
-        ff.max_future = p['joint_states.max_future']
-        ff.max_age = p['joint_states.max_age']
-        if p['drives.compensate']:
-            from ..core.drives import model_drives
-            ff.drives = model_drives(bare)
-        ff.warm_up()   # compile or load the kernels before any message
-        ff.output_names = list(order.output_joints)
-        ff.bare_model = bare
-        ff.bare_scene = scene if previous is None else previous.bare_scene
+        ff = FeedforwardComputer.from_parameters(
+            p, model, order, wrench, bounds, sources, reference, scene,
+            self.mode, bare_model=bare,
+            bare_scene=scene if previous is None else previous.bare_scene)
         return ff
 
     def _log_model(self, ff, source):

@@ -29,7 +29,8 @@ import numpy as np
 
 from ..core.effects import Effects
 from ..core.errors import RobotFileError
-from ..core.model import inertia_matrix, with_payload
+from ..core.inertia import inertia_matrix, principal_moments
+from ..core.model import with_payload
 from ..core.robot_file import (_check_keys, _short, inspect_robot, read_yaml,
                                to_number, to_vector)
 
@@ -259,8 +260,7 @@ def scene_from_dict(data, origin, base_dir='.'):
         com = to_vector(block.get('com', [0.0] * 3), 3, f'{w}.payload.com')
         inertia = inertia_matrix(*to_vector(block.get('inertia', [0.0] * 6),
                                             6, f'{w}.payload.inertia'))
-        if np.linalg.eigvalsh(inertia)[0] < -1e-12 * max(
-                1e-300, np.abs(inertia).max()):
+        if not principal_moments(inertia)[1]:
             raise RobotFileError(f'{w}.payload.inertia: must be positive '
                                  f'semidefinite')
         model = with_payload(model, mass, com, inertia)

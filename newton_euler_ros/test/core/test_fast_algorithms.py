@@ -30,7 +30,6 @@ The O(n) forward dynamics and the O(n^2) Coriolis matrix, by identities.
 import math
 
 from hypothesis import given, settings, strategies as st
-from newton_euler_ros.core import _kernels as K
 from newton_euler_ros.core import (coriolis_matrix, coriolis_matrix_batch,
                                    DynamicsInputError, forward_dynamics,
                                    forward_dynamics_batch, gravity_torques,
@@ -39,6 +38,7 @@ from newton_euler_ros.core import (coriolis_matrix, coriolis_matrix_batch,
                                    mass_matrix_batch,
                                    mass_matrix_condition,
                                    NotPositiveDefiniteError, Workspace)
+from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core.model import make_chain, rpy_matrix
 import numpy as np
 import pytest
@@ -256,7 +256,7 @@ import numpy as np
 from numba import njit
 from numba.core.runtime import rtsys
 from newton_euler_ros.core import load_robot, Workspace
-from newton_euler_ros.core import _kernels as K
+from newton_euler_ros.core import kernels as K
 arm = load_robot('planar_rp')
 n = arm.n
 ws = Workspace(arm)

@@ -121,3 +121,65 @@ def test_finite_input_that_overflows_raises(arm, call):
     """Finite input never yields NaN/Inf: an overflow is a clear error."""
     with pytest.raises(DynamicsInputError, match='overflows float64'):
         call(arm)
+
+
+def _as(kind, x):
+    """Return x (a float64 vector) as a list, tuple, int or float32 array."""
+    if kind == 'list':
+        return [float(v) for v in x]
+    if kind == 'tuple':
+        return tuple(x)
+    return np.asarray(x).astype(kind)
+
+
+@pytest.mark.parametrize('kind', ['list', 'tuple', np.int64, np.int32,
+                                  np.float32])
+def test_lists_and_other_dtypes_give_what_float64_arrays_give(kind):
+    # integer-valued states, so that every kind holds the same numbers:
+    # the result must be the float64 result to the last bit
+    arm = load_robot('planar_2r')
+    q = np.array([1.0, -2.0])
+    qd = np.array([3.0, 1.0])
+    qdd = np.array([-1.0, 2.0])
+    w = np.array([0.0, 0.0, 10.0, 0.0, 1.0, 0.0])
+    x = {name: _as(kind, v) for name, v in
+         (('q', q), ('qd', qd), ('qdd', qdd), ('w', w))}
+    pairs = [
+        (inverse_dynamics(arm, q, qd, qdd, w),
+         inverse_dynamics(arm, x['q'], x['qd'], x['qdd'], x['w'])),
+        (inverse_dynamics(arm, q, qd, qdd, w, 'end_effector'),
+         inverse_dynamics(arm, x['q'], qd, x['qdd'], x['w'],
+                          'end_effector')),
+        (gravity_torques(arm, q), gravity_torques(arm, x['q'])),
+        (mass_matrix(arm, q), mass_matrix(arm, x['q'])),
+        (coriolis_matrix(arm, q, qd), coriolis_matrix(arm, x['q'], x['qd'])),
+        (forward_dynamics(arm, q, qd, qdd), forward_dynamics(
+            arm, x['q'], x['qd'], x['qdd'])),
+        (jacobian(arm, q), jacobian(arm, x['q'])),
+    ]
+    for expected, got in pairs:
+        assert got.dtype == np.float64
+        assert np.array_equal(got, expected)
+
+
+def test_a_refused_call_leaves_the_fast_path_intact(arm):
+    """After a list, a float64 array still takes the compiled entry."""
+    q = np.array([0.3, -0.4])
+    first = inverse_dynamics(arm, q)
+    inverse_dynamics(arm, [0.3, -0.4])
+    assert len(dynamics._tau.overloads) == 1    # no second compilation
+    assert np.array_equal(inverse_dynamics(arm, q), first)
+
+
+@pytest.mark.parametrize('call', [
+    lambda m, ws: inverse_dynamics(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: gravity_torques(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: mass_matrix(m, [0.0, 0.0], ws=ws),
+    lambda m, ws: coriolis_matrix(m, [0.0, 0.0], [0.0, 0.0], ws=ws),
+    lambda m, ws: forward_dynamics(m, [0.0, 0.0], [0.0, 0.0], [0.0, 0.0],
+                                   ws=ws),
+])
+def test_a_ws_that_is_no_workspace_is_one_clear_error(arm, call):
+    with pytest.raises(DynamicsInputError, match='ws must be a float64 '
+                                                 'Workspace'):
+        call(arm, np.zeros((2, 21)))

@@ -27,15 +27,14 @@ The composite-rigid-body D(q) and the genuine float32 path.
 """
 import doctest
 import math
-import types
 import warnings
 
 import mpmath
-from newton_euler_ros.core import _kernels as K
 from newton_euler_ros.core import (bundled_robots, DynamicsInputError,
                                    load_robot, make_model, mass_matrix,
                                    mass_matrix_condition)
 from newton_euler_ros.core import float32 as float32_module
+from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core.float32 import Float32Dynamics
 from newton_euler_ros.core.highprec import HighPrecisionModel, relative_error
 from newton_euler_ros.core.model import pose_matrix, rpy_matrix
@@ -176,14 +175,9 @@ def test_crba_overflow_raises():
 # ---------------------------------------------------------------------------
 
 def _fresh_kernels():
-    """Compile the kernel source anew (no disk cache: full type maps)."""
-    module = types.ModuleType('newton_euler_ros.core._kernels_typed')
-    module.__dict__['__njit_override__'] = lambda f=None, **kw: (
-        numba.njit(f) if f is not None else numba.njit)
-    path = K.__file__
-    with open(path, encoding='utf-8') as fh:
-        exec(compile(fh.read(), path, 'exec'), module.__dict__)  # noqa: S102
-    return module
+    """Compile the kernel files anew (no disk cache: full type maps)."""
+    return K.load_copy('typed', lambda f=None, **kw: (
+        numba.njit(f) if f is not None else numba.njit))
 
 
 def _has_float(t, bits):
@@ -242,8 +236,8 @@ def _run_every_kernel(mod, model, dtype):
     tau = np.zeros(n, f)
     M = np.zeros((n, n), f)
     for mode in (mod.WRENCH_NONE, mod.WRENCH_BASE, mod.WRENCH_EE):
-        assert mod.inverse_dynamics(links, frames, q, q, q, w, True, True,
-                                    mode, ws, tau) == -1
+        mod.joint_trig(links, frames, q, ws)
+        mod.recursion(links, frames, q, q, q, w, True, True, mode, ws, tau)
     Q = np.tile(q, (3, 1))
     TAU = np.zeros((3, n), f)
     W = np.zeros((3, 6), f)
@@ -275,10 +269,11 @@ def _run_every_kernel(mod, model, dtype):
     assert mod.run_mass_matrix_batch(P, Q, ws, MM, status) == -1
     assert mod.run_gravity_torques_batch(P, Q, ws, TAU, status) == -1
     assert mod.run_coriolis_matrix_batch(P, Q, Q, ws, cw, MM, status) == -1
-    assert mod.mass_matrix(links, frames, q, ws, scratch, M) == -1
+    assert mod.mass_matrix_columns(links, frames, q, ws, scratch, M) == -1
     D = M.copy()
     assert mod.mass_matrix_crba(links, frames, q, ws, M) == -1
-    assert mod.coriolis_matrix(links, frames, q, q, ws, scratch, M) == -1
+    assert mod.coriolis_matrix_columns(links, frames, q, q, ws, scratch,
+                                       M) == -1
     Ts = np.zeros((n + 2, 12), f)
     mod.forward_kinematics(links, frames, q, ws, Ts)
     J = np.zeros((6, n), f)

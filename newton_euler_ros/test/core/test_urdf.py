@@ -210,6 +210,92 @@ def test_fixed_joints_merge_by_the_parallel_axis_theorem():
         1.0 + 2.0 * 0.0 + 1.0 * 0.09, rel=1e-15)
 
 
+def test_rotated_fixed_joint_rotates_the_merged_inertia():
+    # link a (massless, no inertial) carries b through a fixed joint with
+    # a 90 deg yaw and no translation: b's anisotropic diag(1, 2, 3) about
+    # its com at its origin becomes diag(2, 1, 3) in a's axes (a yaw of
+    # 90 deg maps b's x axis onto a's y axis, so Ixx and Iyy swap).  An
+    # off-axis com (0.1, 0, 0) in b turns into (0, 0.1, 0) in a.
+    text = f"""<robot name="r"><link name="base"/><link name="a"/>
+      <link name="b">{inertial(2.0, '0.1 0 0', ixx=1.0, iyy=2.0,
+                                izz=3.0)}</link>
+      <joint name="j" type="revolute"><parent link="base"/>
+        <child link="a"/><axis xyz="0 0 1"/>
+        <limit lower="-3" upper="3" effort="50" velocity="1"/></joint>
+      <joint name="weld" type="fixed"><parent link="a"/><child link="b"/>
+        <origin rpy="0 0 1.5707963267948966"/></joint></robot>"""
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', RobotFileWarning)
+        model = load_urdf(text)
+    assert model.info['urdf']['merged_fixed'] == ['weld']
+    assert model.mass[0] == 2.0
+    np.testing.assert_allclose(model.com[0], [0.0, 0.1, 0.0], atol=1e-16)
+    np.testing.assert_allclose(model.inertia[0], np.diag([2.0, 1.0, 3.0]),
+                               atol=1e-15)
+    # about the vertical joint axis: Izz + m r^2 = 3 + 2 (0.1)^2
+    assert mass_matrix(model, [0.4])[0, 0] == pytest.approx(3.02, rel=1e-15)
+
+
+TILTED = ('<robot name="r"><link name="base"/>{links}'
+          '<joint name="j1" type="revolute"><parent link="base"/>'
+          '<child link="a"/><axis xyz="0 0 1"/><origin xyz="0 0 0.2"/>'
+          '<limit lower="-3" upper="3" effort="50" velocity="1"/></joint>'
+          '<joint name="j2" type="revolute"><parent link="a"/>'
+          '<child link="b"/><axis xyz="0 1 0"/><origin xyz="0.3 0 0"/>'
+          '<limit lower="-3" upper="3" effort="50" velocity="1"/></joint>'
+          '{extra}</robot>')
+
+
+def test_a_body_through_an_extra_rotated_fixed_joint_has_the_same_dynamics():
+    # The same body of link b written twice: directly in b, and in a link
+    # c welded to b by a fixed joint with a general rotation and offset,
+    # its inertial re-expressed in c's axes by hand (c's pose in b is
+    # (R, p): com_c = R^T (com_b - p), I_c = R^T I_b R).  The dynamics
+    # must not tell them apart.
+    from newton_euler_ros.core.model import pose_matrix
+    com_b = np.array([0.05, -0.02, 0.1])
+    I_b = np.array([[0.02, 0.003, -0.001], [0.003, 0.05, 0.002],
+                    [-0.001, 0.002, 0.07]])
+    xyz, rpy = (0.1, 0.2, -0.05), (0.4, -0.7, 1.1)
+    T = pose_matrix(xyz, rpy)
+    R, p = T[:3, :3], T[:3, 3]
+    com_c = R.T @ (com_b - p)
+    I_c = R.T @ I_b @ R
+
+    def body(name, m, com, inertia):
+        i = inertia
+        return (f'<link name="{name}"><inertial><origin xyz="'
+                f'{" ".join(repr(float(x)) for x in com)}"/>'
+                f'<mass value="{m}"/><inertia ixx="{float(i[0, 0])!r}" '
+                f'ixy="{float(i[0, 1])!r}" ixz="{float(i[0, 2])!r}" '
+                f'iyy="{float(i[1, 1])!r}" iyz="{float(i[1, 2])!r}" '
+                f'izz="{float(i[2, 2])!r}"/></inertial></link>')
+
+    a = body('a', 1.0, [0.1, 0.0, 0.0], np.diag([0.01, 0.02, 0.03]))
+    direct = TILTED.format(links=a + body('b', 1.5, com_b, I_b), extra='')
+    welded = TILTED.format(
+        links=a + '<link name="b"/>' + body('c', 1.5, com_c, I_c),
+        extra=('<joint name="weld" type="fixed"><parent link="b"/>'
+               f'<child link="c"/><origin xyz="{" ".join(map(str, xyz))}" '
+               f'rpy="{" ".join(map(str, rpy))}"/></joint>'))
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore', RobotFileWarning)
+        one = load_urdf(direct)
+        two = load_urdf(welded)
+    assert two.info['urdf']['merged_fixed'] == ['weld']
+    assert two.mass.tolist() == one.mass.tolist()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q, qd, qdd = rng.uniform(-2, 2, (3, 2))
+        assert rel(inverse_dynamics(two, q, qd, qdd),
+                   inverse_dynamics(one, q, qd, qdd)) < 50 * EPS
+        assert rel(mass_matrix(two, q), mass_matrix(one, q)) < 50 * EPS
+        assert rel(coriolis_matrix(two, q, qd),
+                   coriolis_matrix(one, q, qd)) < 50 * EPS
+        assert rel(gravity_torques(two, q), gravity_torques(one, q)) \
+            < 50 * EPS
+
+
 def test_total_mass_is_every_link_that_rides_on_the_chain():
     model = arm(base='world', tip='tool0')
     # base_link (5 kg) is fixed to the world; l1, l2 + finger, l3 move

@@ -188,3 +188,30 @@ def test_future_wrench_rejected_and_bad_state_not_remembered(puma):
     with pytest.raises(InputRejected, match='overflows float64'):
         ff.torques(names6(), np.zeros(6), np.full(6, 1e308), 0.0, 0.0)
     assert ff.last_q is None          # a rejected state is not "latest"
+
+
+def test_computer_built_in_one_call_from_parameters(puma):
+    from newton_euler_ros.safety import effort_bounds, velocity_bounds
+    order = JointOrder(puma.joint_names, list(reversed(puma.joint_names)))
+    params = {'limits.action': 'clamp', 'limits.velocity_factor': 2.0,
+              'limits.max_velocity': 20.0, 'joint_states.max_future': 0.5,
+              'joint_states.max_age': 2.0}
+    bounds, sources = effort_bounds(puma)
+    ff = FeedforwardComputer.from_parameters(
+        params, puma, order, WrenchInput([], []), bounds, sources)
+    assert ff.mode == 'gravity_coriolis' and ff.model is puma
+    assert ff.output_names == list(reversed(puma.joint_names))
+    assert ff.guard.action == 'clamp'
+    assert ff.guard.bounds.tolist() == bounds[::-1].tolist()
+    assert ff.bound_sources == sources[::-1]
+    np.testing.assert_array_equal(ff.velocity_bounds,
+                                  velocity_bounds(puma, 2.0, 20.0))
+    assert (ff.max_future, ff.max_age) == (0.5, 2.0)
+    assert ff.bare_model is puma and ff.bare_scene is None
+    with pytest.raises(InputRejected, match='in the future'):
+        ff.torques(names6(), np.zeros(6), np.zeros(6), stamp=1.0, now=0.0)
+    # a computer built without parameters guards nothing and accepts any
+    # plausible stamp, as before
+    plain = FeedforwardComputer(puma, order, WrenchInput([], []))
+    assert plain.guard is None and plain.velocity_bounds is None
+    assert (plain.max_future, plain.max_age) == (1.0, 0.0)

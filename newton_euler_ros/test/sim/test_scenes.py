@@ -15,7 +15,7 @@
 """Scenes and simulation: only the effects a scene calls for, by physics."""
 import copy
 
-from newton_euler_ros.core import _kernels as K, dynamics
+from newton_euler_ros.core import dynamics, kernels as K
 from newton_euler_ros.core import (gravity_torques, inverse_dynamics,
                                    load_robot, RobotFileError)
 from newton_euler_ros.core.model import with_payload

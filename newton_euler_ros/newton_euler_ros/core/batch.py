@@ -1,0 +1,117 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The dynamics of many states at once: one compiled loop per term.
+
+``inverse_dynamics_batch``, ``mass_matrix_batch``, ``coriolis_matrix_batch``,
+``gravity_torques_batch`` and ``forward_dynamics_batch`` take (m, n) arrays
+of states, check them once in numpy (shapes, finiteness) and run the
+batch entry point of their kernel (``kernels/entry.py``, beside the
+single-state one): no Python work per state.  All are importable from
+:mod:`newton_euler_ros.core` and :mod:`newton_euler_ros.core.dynamics`.
+"""
+import numpy as np
+
+from . import kernels as K
+from .calling import matrix, out_array, status_error, workspace, wrench_mode
+
+
+def _states(model, ws, Q, QD, name_qd='QD'):
+    ws = workspace(model, ws)
+    Q = matrix('Q', Q, ws.n)
+    QD = None if QD is None else matrix(name_qd, QD, ws.n, Q.shape[0])
+    return ws, Q, QD
+
+
+def _wrenches(W, wrench_frame, m):
+    if W is None:
+        return np.zeros((m, 6)), K.WRENCH_NONE
+    return matrix('W', W, 6, m), wrench_mode(W, wrench_frame)
+
+
+def _check(row, ws, model=None, Q=None):
+    """Raise for the first failed row of a batch (its code in ws.status)."""
+    if row >= 0:
+        raise status_error(int(ws.status[0]), model=model,
+                           q=None if Q is None else Q[row], ws=ws, row=row)
+
+
+def inverse_dynamics_batch(model, Q, QD=None, QDD=None, W=None,
+                           wrench_frame='base', *, gravity=True,
+                           velocity_products=True, ws=None, out=None):
+    """
+    :func:`~newton_euler_ros.core.dynamics.inverse_dynamics` for each row.
+
+    Of (m, n) arrays of states; ``W`` is an (m, 6) array of wrenches or
+    None.  Returns (m, n).  One compiled loop: no Python work per state.
+    """
+    ws, Q, QD = _states(model, ws, Q, QD)
+    m = Q.shape[0]
+    QD = np.zeros_like(Q) if QD is None else QD
+    QDD = np.zeros_like(Q) if QDD is None else matrix('QDD', QDD, ws.n, m)
+    W, mode = _wrenches(W, wrench_frame, m)
+    TAU = out_array(out, Q.shape)
+    _check(K.run_inverse_dynamics_batch(
+        model.packed, Q, QD, QDD, W, K.flags(gravity, velocity_products, mode),
+        ws.ws, TAU, ws.status), ws)
+    return TAU
+
+
+def gravity_torques_batch(model, Q, *, ws=None, out=None):
+    """:func:`gravity_torques` for each row of an (m, n) array; (m, n)."""
+    ws, Q, _ = _states(model, ws, Q, None)
+    G = out_array(out, Q.shape)
+    _check(K.run_gravity_torques_batch(model.packed, Q, ws.ws, G, ws.status),
+           ws)
+    return G
+
+
+def mass_matrix_batch(model, Q, *, ws=None, out=None):
+    """:func:`mass_matrix` (CRBA) for each row of Q; returns (m, n, n)."""
+    ws, Q, _ = _states(model, ws, Q, None)
+    DD = out_array(out, (Q.shape[0], ws.n, ws.n))
+    _check(K.run_mass_matrix_batch(model.packed, Q, ws.ws, DD, ws.status), ws)
+    return DD
+
+
+def coriolis_matrix_batch(model, Q, QD, *, ws=None, out=None):
+    """:func:`coriolis_matrix` (composite) for each row; (m, n, n)."""
+    ws, Q, QD = _states(model, ws, Q, QD)
+    QD = np.zeros_like(Q) if QD is None else QD
+    CC = out_array(out, (Q.shape[0], ws.n, ws.n))
+    _check(K.run_coriolis_matrix_batch(model.packed, Q, QD, ws.ws, ws.cw, CC,
+                                       ws.status), ws)
+    return CC
+
+
+def forward_dynamics_batch(model, Q, QD, TAU, W=None, wrench_frame='base', *,
+                           gravity=True, velocity_products=True, ws=None,
+                           out=None):
+    """
+    :func:`forward_dynamics` (articulated-body) for each row; (m, n).
+
+    Raises :class:`NotPositiveDefiniteError` for the first row where D is
+    singular, naming the row and the joint.
+    """
+    ws, Q, QD = _states(model, ws, Q, QD)
+    m = Q.shape[0]
+    QD = np.zeros_like(Q) if QD is None else QD
+    TAU = matrix('TAU', TAU, ws.n, m)
+    W, mode = _wrenches(W, wrench_frame, m)
+    QDD = out_array(out, Q.shape)
+    _check(K.run_forward_dynamics_batch(
+        model.packed, Q, QD, TAU, W, K.flags(gravity, velocity_products, mode),
+        ws.ws, ws.aw, QDD, ws.status), ws, model, Q)
+    return QDD

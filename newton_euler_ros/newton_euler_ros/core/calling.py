@@ -1,0 +1,274 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+How Python calls the kernels: strict entries, conversion, status decoding.
+
+The one entry path of every dynamics function is
+
+1. the fast call: the arguments as given, straight into a *strict entry*
+   (:func:`strict_entry`), a numba dispatcher compiled for exactly
+   float64, C-contiguous, writeable arrays.  numba's dispatcher matches
+   argument types in C on every call anyway; for anything else (a list,
+   an int or float32 array, a read-only or strided array) it finds no
+   match and, instead of numba's slow search for a conversion (about
+   100 us), raises :class:`Refused` at once (about 1 us);
+2. only then, or when the kernel returns a status code: the arguments
+   converted once (:func:`vector`, :func:`out_array`,
+   :func:`workspace`), the kernel called again, and its status decoded
+   here (:func:`status_error`) into the one-line errors users see.
+
+So a float64 array costs no Python check at all, and a list costs one
+conversion more.
+"""
+import math
+
+from numba import njit, types
+import numpy as np
+
+from . import kernels as K
+from .errors import DynamicsInputError, NotPositiveDefiniteError
+from .workspace import Workspace
+
+INPUTS = ('q', 'qd', 'qdd', 'wrench')
+FD_INPUTS = ('q', 'qd', 'tau', 'wrench')
+WRENCH_FRAMES = {'base': K.WRENCH_BASE, 'end_effector': K.WRENCH_EE}
+MASS_MATRIX_METHODS = ('newton_euler', 'crba')
+CORIOLIS_METHODS = ('composite', 'newton_euler')
+FORWARD_DYNAMICS_METHODS = ('aba', 'cholesky')
+
+# argument types of the strict entries
+F8 = types.float64
+VEC = types.Array(F8, 1, 'C')
+MAT = types.Array(F8, 2, 'C')
+PACKED = types.Array(F8, 2, 'C', readonly=True)
+INT = types.int64
+BOOL = types.boolean
+
+
+class Refused(Exception):
+    """A strict entry was given an argument of another type: convert it."""
+
+
+def _refuse(*args, **kws):
+    raise Refused
+
+
+def strict_entry(kernel, *argtypes):
+    """
+    Return ``kernel`` compiled for exactly ``argtypes``, on first call.
+
+    The dispatcher takes the entry points' options (``kernels.ENTRY``:
+    numba's cache does not tell compilations of one function with other
+    options apart) and compiles the one signature on its first call (or
+    loads it from the cache), then no other: numba then asks its
+    ``_search_new_conversions`` callback about arguments of any other
+    type, which raises :class:`Refused`.
+    """
+    dispatcher = njit(**K.ENTRY)(kernel.py_func)
+    signature = types.int64(*argtypes)
+
+    def first_call(*args, **kws):
+        # numba calls what this returns with the arguments: the
+        # dispatcher itself, now holding the one signature and no other
+        dispatcher.compile(signature)
+        dispatcher.disable_compile()
+        return dispatcher
+
+    # numba's callbacks on a type miss: while it may compile, and after
+    dispatcher._compile_for_args = first_call
+    dispatcher._search_new_conversions = _refuse
+    return dispatcher
+
+
+# ---------------------------------------------------------------------------
+# conversions, once
+
+def workspace(model, ws):
+    """Return ``ws`` once checked against the model (None: the default)."""
+    if ws is None:
+        return model.default_workspace
+    if type(ws) is not Workspace or ws.n != model.n \
+            or ws.dtype != np.float64:
+        raise DynamicsInputError(
+            f'ws must be a float64 Workspace for a model of {model.n} '
+            f'joints, got {ws!r}')
+    return ws
+
+
+def foreign_workspace(model, ws):
+    """
+    Raise the one-line error for a ``ws`` that is not a Workspace at all.
+
+    Called where a fast path met an AttributeError: for any other ``ws``
+    it returns, and the caller re-raises the AttributeError (a bug).
+    """
+    if ws is not None and type(ws) is not Workspace:
+        workspace(model, ws)
+
+
+def vector(name, x, size):
+    """Return x as a contiguous float64 vector of the given size, or raise."""
+    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1
+            and x.flags.c_contiguous and x.flags.writeable):
+        arr = x
+    else:
+        try:
+            arr = np.array(x, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise DynamicsInputError(
+                f'{name} must be a sequence of {size} numbers: {exc}') from None
+        if arr.ndim != 1:
+            raise DynamicsInputError(
+                f'{name} must be a vector of {size} numbers, '
+                f'got shape {arr.shape}')
+    if arr.shape[0] != size:
+        raise DynamicsInputError(
+            f'{name} must have {size} entries, got {arr.shape[0]}')
+    return arr
+
+
+def out_array(out, shape, dtype=np.float64):
+    """Return a new array of ``shape``, or ``out`` once checked."""
+    if out is None:
+        return np.empty(shape, dtype)
+    if (type(out) is not np.ndarray or out.dtype != dtype
+            or out.shape != shape or not out.flags.c_contiguous
+            or not out.flags.writeable):
+        raise DynamicsInputError(
+            f'out must be a writeable, C-contiguous {np.dtype(dtype).name} '
+            f'array of shape {shape}, got '
+            + (f'{out.dtype} {out.shape}' if isinstance(out, np.ndarray)
+               else type(out).__name__))
+    return out
+
+
+def matrix(name, X, cols, rows=None):
+    """Return X as a finite, C-contiguous float64 (rows, cols), or raise."""
+    try:
+        X = np.ascontiguousarray(X, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise DynamicsInputError(f'{name} must be numeric: {exc}') from None
+    if X.ndim != 2 or X.shape[1] != cols or (rows is not None
+                                             and X.shape[0] != rows):
+        want = f'({rows if rows is not None else "m"}, {cols})'
+        raise DynamicsInputError(
+            f'{name} must have shape {want}, got {X.shape}')
+    if not X.flags.writeable:
+        X = X.copy()
+    bad = np.argwhere(~np.isfinite(X))
+    if bad.size:
+        r, c = bad[0]
+        raise DynamicsInputError(
+            f'{name}[{r}, {c}] is {float(X[r, c])!r}; every entry must be '
+            f'finite')
+    return X
+
+
+def wrench_mode(wrench, wrench_frame):
+    """Return the kernels' wrench mode for a wrench and its frame name."""
+    if wrench is None:
+        return K.WRENCH_NONE
+    try:
+        return WRENCH_FRAMES[wrench_frame]
+    except KeyError:
+        raise DynamicsInputError(
+            f"wrench_frame must be 'base' or 'end_effector', "
+            f'got {wrench_frame!r}') from None
+
+
+def bad_method(method, methods=MASS_MATRIX_METHODS):
+    """Return the ValueError for an unknown ``method``."""
+    return ValueError(
+        f'method must be one of {", ".join(map(repr, methods))}'
+        f', got {method!r}')
+
+
+# ---------------------------------------------------------------------------
+# status codes, decoded once
+
+def status_error(code, values=(), names=INPUTS, precision='float64',
+                 model=None, q=None, ws=None, row=None, given=None):
+    """
+    Return the exception a kernel's status code (>= 0) stands for.
+
+    ``values``: the inputs as the kernel saw them (for the non-finite
+    entry's value); ``given``: the inputs as the caller gave them, when
+    the kernel saw them rounded (float32: a finite input beyond its
+    range became inf); ``model``, ``q`` and ``ws`` name the joint of a
+    singular mass matrix; ``row`` the row of a batch.
+    """
+    at = '' if row is None else f' for row {row}'
+    if code >= K.SINGULAR:
+        err = not_positive_definite(model, q, code - K.SINGULAR, ws)
+        if row is None:
+            return err
+        return NotPositiveDefiniteError(f'row {row}: {err}', err.joint)
+    if code == K.OVERFLOW:
+        return DynamicsInputError(
+            f'the result{at} overflows {precision} (inputs too large); '
+            f'nothing is returned')
+    if code >= K.SIZE:
+        # sizes are checked in Python before a second call; only a
+        # workspace of another size can get here
+        return DynamicsInputError(
+            'ws does not fit this model (made for another number of joints)')
+    arg, i = divmod(code, K.NONFINITE)
+    if given is not None and given[arg] is not None:
+        value = float(np.ravel(np.asarray(given[arg], dtype=np.float64))[i])
+        if math.isfinite(value):
+            limit = float(np.finfo(precision).max)
+            return DynamicsInputError(
+                f'{names[arg]}[{i}] is {value!r}, outside the {precision} '
+                f'range (|x| <= {limit:.8g})')
+    return DynamicsInputError(
+        f'{names[arg]}[{i}] is {float(values[arg][i])!r}; every entry must '
+        f'be finite')
+
+
+def first_singular_pivot(D, rtol=1e-12):
+    """
+    Return the first joint where D is not positive definite, or None.
+
+    The kernels' Cholesky factorisation of D - rtol max|diag D| 1: a
+    pivot that is not clearly positive (relative to D's scale) counts.
+    """
+    D = np.asarray(D, dtype=np.float64)
+    n = D.shape[0]
+    scale = max(float(np.abs(np.diag(D)).max()), 1e-300) if n else 1.0
+    shifted = D - rtol * scale * np.eye(n)
+    bad = K.cholesky_solve(shifted, np.zeros(n), np.zeros((n, n)),
+                           np.empty(n))
+    return None if bad < 0 else int(bad)
+
+
+def not_positive_definite(model, q, j, ws):
+    """
+    Return the NotPositiveDefiniteError for a singular D (first joint).
+
+    The articulated-body algorithm meets the singularity from the tip; the
+    joint named is the first one (from the base) at which the leading
+    block of D stops being positive definite, as a Cholesky factorisation
+    finds it, so both methods name the same joint.
+    """
+    ws = workspace(model, ws)
+    D = np.empty((model.n, model.n))
+    K.run_mass_matrix_crba(model.packed, vector('q', q, model.n), ws.ws, D)
+    bad = K.cholesky_solve(D, ws.zeros, ws.chol, np.empty(model.n))
+    if bad < 0:
+        bad = j
+    return NotPositiveDefiniteError(
+        f'the mass matrix is not positive definite at joint {bad} '
+        f'({model.joint_names[bad]}): no mass or inertia moves with that '
+        f'joint given the joints before it', bad)

@@ -1,0 +1,146 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Compiled kernels: the derivation's passes, one file each.
+
+=====================  ====================================================
+file                   what it holds
+=====================  ====================================================
+``newton_euler.py``    the Newton-Euler recursion: the forward pass (base
+                       to tip: velocities, accelerations, each link's net
+                       force and moment) and the backward pass (tip to
+                       base: the force balance, the joint torques), with
+                       the tip wrench beside them; g(q); D and C column by
+                       column from unit inputs
+``crba.py``            D(q) by the composite-rigid-body algorithm
+``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
+``aba.py``             qdd by the articulated-body algorithm
+``kinematics.py``      joint placements, link poses, spatial inertias and
+                       the Jacobian
+``spatial.py``         3-vector and 6x6 helpers; the one force carry
+                       (``force_to_parent``) and the one motion carry
+                       (``motion_to_child``)
+``cholesky.py``        Cholesky solve
+``status.py``          finiteness checks and status codes in the kernels
+``layout.py``          every array column by name (``L_*``, ``F_*``,
+                       ``W_*``, ``A_*``, ``CW_*``), flags, status codes
+``entry.py``           what Python calls: one entry point per term and its
+                       batch loop beside it, checking sizes and values
+``_jit.py``            ``njit``, the entry options, on-disk caching
+=====================  ====================================================
+
+Everything is scalar code over 3-tuples so that numba compiles it to tight
+machine code, and so that the very same source runs in plain Python on
+other number types (:func:`load_copy`: the 50-digit reference runs these
+files with ``njit`` replaced by the identity).  Nothing allocates in the
+hot path: callers pass workspace arrays.
+
+Number types.  The kernels are generic in the dtype of the arrays they
+are given: they contain no float literal (numba types one as float64, and
+float32 op float64 is float64), taking 0, 1/2 and 1 from the constants
+row ``frames[F_CONST]`` instead, and comparing with integer literals only.
+So float64 arrays give float64 arithmetic, float32 arrays float32
+arithmetic throughout (``core.float32``; the tests check numba's type
+maps), and mpf object arrays mpmath arithmetic (``core.highprec``).
+"""
+import os
+import sys
+import types
+
+from ._jit import ENTRY
+from .aba import articulated_body
+from .cholesky import cholesky_solve
+from .coriolis import coriolis_matrix_composite
+from .crba import mass_matrix_crba
+from .entry import (run_coriolis_matrix, run_coriolis_matrix_batch,
+                    run_forward_dynamics, run_forward_dynamics_batch,
+                    run_gravity_torques, run_gravity_torques_batch,
+                    run_inverse_dynamics, run_inverse_dynamics_batch,
+                    run_jacobian, run_link_poses, run_mass_matrix,
+                    run_mass_matrix_batch, run_mass_matrix_crba)
+from .kinematics import forward_kinematics, jacobian, joint_trig
+from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
+                     C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
+                     CW_F2, CW_G, CW_I, CW_OW, CW_RW, CW_S, CW_SD, CW_V,
+                     CW_WIDTH, F_BASE, F_CONST, F_GRAV, F_ROWS, F_TOOL, flags,
+                     GRAVITY, L_BODY, L_COM, L_INERTIA, L_MASS, L_P, L_R,
+                     L_TYPE, L_WIDTH, NONFINITE, OVERFLOW, pack, SINGULAR,
+                     SIZE, VELOCITY, W_CT, W_DD, W_F, W_N, W_P, W_R, W_ST,
+                     W_WIDTH, WRENCH_BASE, WRENCH_EE, WRENCH_NONE,
+                     WRENCH_SHIFT)
+from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
+                           recursion, unit_columns)
+from .status import check_finite, first_nonfinite, round_into
+
+__all__ = [
+    'A_C', 'A_D', 'A_IA', 'A_PA', 'A_U', 'A_UU', 'A_V', 'A_WIDTH',
+    'articulated_body', 'C_HALF', 'C_ONE', 'C_ZERO', 'check_finite',
+    'cholesky_solve', 'CONSTANTS', 'coriolis_matrix_columns',
+    'coriolis_matrix_composite', 'CS_BC', 'CS_H', 'CS_IC', 'CW_F1',
+    'CW_F2', 'CW_G', 'CW_I', 'CW_OW', 'CW_RW', 'CW_S', 'CW_SD', 'CW_V',
+    'CW_WIDTH', 'ENTRY', 'F_BASE', 'F_CONST', 'F_GRAV', 'F_ROWS', 'F_TOOL',
+    'first_nonfinite', 'flags', 'forward_kinematics', 'GRAVITY',
+    'jacobian', 'joint_trig', 'L_BODY', 'L_COM', 'L_INERTIA', 'L_MASS',
+    'L_P', 'L_R', 'L_TYPE', 'L_WIDTH', 'mass_matrix_columns',
+    'mass_matrix_crba', 'NONFINITE', 'OVERFLOW', 'pack', 'recursion',
+    'round_into', 'run_coriolis_matrix', 'run_coriolis_matrix_batch',
+    'run_forward_dynamics', 'run_forward_dynamics_batch',
+    'run_gravity_torques', 'run_gravity_torques_batch',
+    'run_inverse_dynamics', 'run_inverse_dynamics_batch', 'run_jacobian',
+    'run_link_poses', 'run_mass_matrix', 'run_mass_matrix_batch',
+    'run_mass_matrix_crba', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
+    'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
+    'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',
+]
+
+# the kernel files in the order they import each other
+MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
+           'newton_euler', 'crba', 'coriolis', 'aba', 'entry')
+_DIR = os.path.dirname(os.path.abspath(__file__))
+
+
+def load_copy(tag, decorator, math_module=None):
+    """
+    Run the kernel files again as a separate package; return its namespace.
+
+    ``decorator`` replaces ``njit`` (called as ``njit(f)`` or
+    ``njit(**options)``); ``math_module``, if given, replaces ``math`` in
+    every file.  The copy is registered as
+    ``newton_euler_ros.core.kernels_<tag>`` so that the files' relative
+    imports find each other's copies; the returned module holds every
+    name of every file (for ``copy.recursion`` and the like).
+    """
+    name = f'{__name__}_{tag}'
+    package = types.ModuleType(name)
+    package.__path__ = []
+    sys.modules[name] = package
+    flat = types.ModuleType(name + '.flat')
+    for sub in MODULES:
+        module = types.ModuleType(f'{name}.{sub}')
+        module.__package__ = name
+        module.__file__ = os.path.join(_DIR, sub + '.py')
+        if sub == '_jit':
+            module.__dict__['__njit_override__'] = decorator
+        sys.modules[module.__name__] = module
+        with open(module.__file__, encoding='utf-8') as fh:
+            code = compile(fh.read(), module.__file__, 'exec')
+        exec(code, module.__dict__)  # noqa: S102 - our own source files
+        if math_module is not None and 'math' in module.__dict__:
+            module.__dict__['math'] = math_module
+        setattr(package, sub, module)
+        for key, value in vars(module).items():
+            if not key.startswith('__'):
+                setattr(flat, key, value)
+    return flat

@@ -1,0 +1,51 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""Cholesky solve of a symmetric positive definite system (no inverse)."""
+import math
+
+from ._jit import njit
+
+
+@njit(cache=True)
+def cholesky_solve(A, b, L, x):
+    """
+    Solve A x = b for symmetric positive definite A by Cholesky.
+
+    Returns -1 on success, or the index of the first pivot that is not
+    positive (A is not positive definite there).  A is left unchanged.
+    """
+    n = A.shape[0]
+    for i in range(n):
+        for k in range(i + 1):
+            acc = A[i, k]
+            for m in range(k):
+                acc -= L[i, m] * L[k, m]
+            if i == k:
+                if not acc > 0:     # an int literal: exact in any dtype
+                    return i
+                L[i, i] = math.sqrt(acc)
+            else:
+                L[i, k] = acc / L[k, k]
+    for i in range(n):
+        acc = b[i]
+        for m in range(i):
+            acc -= L[i, m] * x[m]
+        x[i] = acc / L[i, i]
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for m in range(i + 1, n):
+            acc -= L[m, i] * x[m]
+        x[i] = acc / L[i, i]
+    return -1

@@ -1,0 +1,198 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The Christoffel Coriolis matrix C(q, qd) in O(n^2) from composite bodies.
+
+Spatial (6-vector) algebra in frame 0: a motion vector is [angular;
+linear] and a force [moment; force], at the origin of frame 0 (the
+convention of Featherstone's book).
+"""
+from ._jit import njit
+from .kinematics import body_inertia, joint_trig, link_geometry, revolute
+from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_OW,
+                     CW_RW, CW_S, CW_SD, CW_V, F_CONST)
+from .spatial import cross, load3, load9, mat6_vec, matmul, rot, skew, vec6
+from .status import matrix_status
+
+
+@njit(cache=True, inline='always')
+def coriolis_forward(links, frames, qd, ws, cw):
+    """
+    Coriolis pass 1, base to tip, everything in frame 0 about its origin.
+
+    Stores each kernel frame's pose, each joint's motion subspace S_j
+    ([z; o x z] revolute, [0; z] prismatic), each link's velocity
+    V_j = V_{j-1} + S_j qd_j and Sdot_j = V_j x S_j.
+    """
+    n = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    one = frames[F_CONST, C_ONE]
+    Rw = (one, zero, zero, zero, one, zero, zero, zero, one)
+    ow = (zero, zero, zero)
+    V = (zero, zero, zero, zero, zero, zero)
+    for j in range(n):
+        R, p = link_geometry(links, frames, j, ws)
+        t = rot(Rw, p[0], p[1], p[2])
+        ow = (ow[0] + t[0], ow[1] + t[1], ow[2] + t[2])
+        Rw = matmul(Rw, R)
+        z = (Rw[2], Rw[5], Rw[8])
+        if revolute(links, frames, j):
+            v = cross(ow[0], ow[1], ow[2], z[0], z[1], z[2])
+            S = (z[0], z[1], z[2], v[0], v[1], v[2])
+        else:
+            S = (zero, zero, zero, z[0], z[1], z[2])
+        s = qd[j]
+        V = (V[0] + S[0] * s, V[1] + S[1] * s, V[2] + S[2] * s,
+             V[3] + S[3] * s, V[4] + S[4] * s, V[5] + S[5] * s)
+        # motion cross product V x S = [w x s_w; w x s_v + v x s_w]
+        a = cross(V[0], V[1], V[2], S[0], S[1], S[2])
+        b = cross(V[0], V[1], V[2], S[3], S[4], S[5])
+        c = cross(V[3], V[4], V[5], S[0], S[1], S[2])
+        Sd = (a[0], a[1], a[2], b[0] + c[0], b[1] + c[1], b[2] + c[2])
+        for k in range(6):
+            cw[j, CW_S + k] = S[k]
+            cw[j, CW_SD + k] = Sd[k]
+            cw[j, CW_V + k] = V[k]
+        for k in range(9):
+            cw[j, CW_RW + k] = Rw[k]
+        for k in range(3):
+            cw[j, CW_OW + k] = ow[k]
+
+
+@njit(cache=True, inline='always')
+def coriolis_backward(links, frames, cw):
+    """
+    Coriolis pass 2, tip to base: composite inertia and Coriolis matrices.
+
+    With I_k the spatial inertia of link k and
+    B_k = (Y + Y^T + [I_k V_k]^) / 2, Y = (V_k x*) I_k, where
+    [h]^ x = x x* h (Echeandia and Wensing's body Coriolis matrix in a
+    fixed frame), the composites IC_j = sum_{k >= j} I_k and
+    BC_j = sum_{k >= j} B_k give each joint's three vectors
+    F1 = IC S, F2 = BC^T S and G = IC Sdot + BC S.
+    """
+    n = links.shape[0]
+    half = frames[F_CONST, C_HALF]
+    zero = frames[F_CONST, C_ZERO]
+    IC = 0          # scratch row n: IC, BC, I_j V_j
+    BC = 36
+    H = 72
+    for k in range(72):
+        cw[n, k] = zero
+    for j in range(n - 1, -1, -1):
+        Rw = load9(cw, j, CW_RW)
+        ow = load3(cw, j, CW_OW)
+        body_inertia(links, j, Rw, ow, cw, j, CW_I)
+        V = vec6(cw, j, CW_V)
+        mat6_vec(cw, j, CW_I, V, cw, n, H)
+        h = vec6(cw, n, H)
+        # Y = (V x*) I, with V x* = [[w x, v x], [0, w x]], column by
+        # column: Y e = V x* (I e).  B = (Y + Y^T + H) / 2 with
+        # H = [h]^ = [[-[h_n], -[h_f]], [-[h_f], 0]].
+        Hn = skew((h[0], h[1], h[2]))
+        Hf = skew((h[3], h[4], h[5]))
+        for col in range(6):
+            b = CW_I + col
+            m0 = cw[j, b]
+            m1 = cw[j, b + 6]
+            m2 = cw[j, b + 12]
+            f0 = cw[j, b + 18]
+            f1 = cw[j, b + 24]
+            f2 = cw[j, b + 30]
+            t1 = cross(V[0], V[1], V[2], m0, m1, m2)
+            t2 = cross(V[3], V[4], V[5], f0, f1, f2)
+            t3 = cross(V[0], V[1], V[2], f0, f1, f2)
+            y = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2],
+                 t3[0], t3[1], t3[2])
+            for r in range(6):
+                # Y[r, col] goes to B[r, col] and, as Y^T, to B[col, r]
+                cw[n, BC + 6 * r + col] += half * y[r]
+                cw[n, BC + 6 * col + r] += half * y[r]
+        for r in range(3):
+            for s in range(3):
+                cw[n, BC + 6 * r + s] -= half * Hn[3 * r + s]
+                cw[n, BC + 6 * r + s + 3] -= half * Hf[3 * r + s]
+                cw[n, BC + 6 * (r + 3) + s] -= half * Hf[3 * r + s]
+        for k in range(36):
+            cw[n, IC + k] += cw[j, CW_I + k]
+        S = vec6(cw, j, CW_S)
+        Sd = vec6(cw, j, CW_SD)
+        for r in range(6):
+            f1 = zero
+            f2 = zero
+            g = zero
+            for s in range(6):
+                ic = cw[n, IC + 6 * r + s]
+                f1 += ic * S[s]
+                f2 += cw[n, BC + 6 * s + r] * S[s]
+                g += ic * Sd[s] + cw[n, BC + 6 * r + s] * S[s]
+            cw[j, CW_F1 + r] = f1
+            cw[j, CW_F2 + r] = f2
+            cw[j, CW_G + r] = g
+
+
+@njit(cache=True, inline='always')
+def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
+    """
+    Christoffel C(q, qd) in O(n^2) from composite bodies.
+
+    With body Jacobians in a fixed frame, C = sum_k J_k^T (I_k Jdot_k +
+    B_k J_k) (see ``coriolis_backward``).  Column b of J_k is S_b for the
+    joints b up to k, so only the links beyond max(a, b) contribute to
+    C[a, b]:
+
+    - b <= a: C[a, b] = S_a^T (IC_a Sdot_b + BC_a S_b) = F1_a . Sdot_b
+      + F2_a . S_b
+    - b > a:  C[a, b] = S_a^T (IC_b Sdot_b + BC_b S_b) = S_a . G_b
+
+    Two O(n) passes and 18 multiply-adds per entry, against the n
+    recursions of ``coriolis_matrix_columns``; the same C up to round-off.
+    ``cw`` is an (n + 1, CW_WIDTH) workspace.  Returns -1 or OVERFLOW.
+    """
+    n = links.shape[0]
+    joint_trig(links, frames, q, ws)
+    coriolis_forward(links, frames, qd, ws, cw)
+    coriolis_backward(links, frames, cw)
+    for a in range(n):
+        f10 = cw[a, CW_F1]
+        f11 = cw[a, CW_F1 + 1]
+        f12 = cw[a, CW_F1 + 2]
+        f13 = cw[a, CW_F1 + 3]
+        f14 = cw[a, CW_F1 + 4]
+        f15 = cw[a, CW_F1 + 5]
+        f20 = cw[a, CW_F2]
+        f21 = cw[a, CW_F2 + 1]
+        f22 = cw[a, CW_F2 + 2]
+        f23 = cw[a, CW_F2 + 3]
+        f24 = cw[a, CW_F2 + 4]
+        f25 = cw[a, CW_F2 + 5]
+        for b in range(a + 1):
+            C[a, b] = ((f10 * cw[b, CW_SD] + f11 * cw[b, CW_SD + 1]
+                        + f12 * cw[b, CW_SD + 2] + f13 * cw[b, CW_SD + 3]
+                        + f14 * cw[b, CW_SD + 4] + f15 * cw[b, CW_SD + 5])
+                       + (f20 * cw[b, CW_S] + f21 * cw[b, CW_S + 1]
+                          + f22 * cw[b, CW_S + 2] + f23 * cw[b, CW_S + 3]
+                          + f24 * cw[b, CW_S + 4] + f25 * cw[b, CW_S + 5]))
+        s0 = cw[a, CW_S]
+        s1 = cw[a, CW_S + 1]
+        s2 = cw[a, CW_S + 2]
+        s3 = cw[a, CW_S + 3]
+        s4 = cw[a, CW_S + 4]
+        s5 = cw[a, CW_S + 5]
+        for b in range(a + 1, n):
+            C[a, b] = (s0 * cw[b, CW_G] + s1 * cw[b, CW_G + 1]
+                       + s2 * cw[b, CW_G + 2] + s3 * cw[b, CW_G + 3]
+                       + s4 * cw[b, CW_G + 4] + s5 * cw[b, CW_G + 5])
+    return matrix_status(C)

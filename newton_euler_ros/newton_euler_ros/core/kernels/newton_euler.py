@@ -1,0 +1,302 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The Newton-Euler recursion: forward pass, backward pass, tip wrench.
+
+:func:`recursion` is the seed text's algorithm: a forward pass, base to
+tip, carries velocities and accelerations out along the chain and gives
+each link's net force and moment (eqs. (19)-(21)); a backward pass, tip
+to base, balances forces and moments link by link and reads each joint's
+torque off its axis.  :func:`tip_wrench` is the backward pass's starting
+value, the wrench the end effector exerts.  g(q) (:func:`gravity`) and
+the column-by-column D and C (:func:`unit_columns`) are this recursion
+with some inputs zero.
+
+Notation (all vectors of link j are expressed in kernel frame j, whose z
+axis is the axis of joint j through its origin O_j; see
+``model.compile_arrays``):
+
+- ``R``, ``p``: rotation and origin of kernel frame j in frame j-1.
+- ``w``: angular velocity (from qd); ``r``: the *reference* angular velocity
+  (from the second velocity argument ``v``); ``al``: angular acceleration;
+  ``ae``: acceleration of the point O_j; ``ac``: acceleration of the centre
+  of mass.  With ``v == qd`` these are the physical quantities of the
+  seed text and the recursion is its eqs. (19)-(21).
+
+Two velocity streams.  The recursion evaluates
+``Y(q, qd, v, qdd) = D(q) qdd + C(q, qd) v (+ g + J^T F_e)`` where C is the
+Christoffel-symbol Coriolis matrix.  Expanding the Lagrangian with body
+Jacobians J_i gives ``C v = sum_i J_i^T (M_i Jdot_i(qd) v + B_i(V_i) J_i v)``
+with ``B(V) = (M ad_V - ad_V^T M - K(M V)) / 2``, which is skew-symmetric
+(so Ddot - 2C is skew) and satisfies ``B(V) V = -ad_V^T M V`` (so C qd is
+the true velocity-product torque).  Written at the centre of mass in
+3-vectors this becomes the classical recursion with
+``w x (w x c)`` -> ``w x (r x c)``,
+``w_{j-1} x z qd_j`` -> ``r_{j-1} x z qd_j`` (revolute),
+``2 w x z qd_j`` -> ``(r x z) qd_j + (w x z) v_j`` (prismatic) and
+``w x I w`` -> ``(w x I r + r x I w + I (w x r)) / 2``.
+Every replacement reduces to the physical term exactly when ``v == qd``.
+
+The prismatic Coriolis term is ``2 w x z qd``: the seed's eqs. (15)-(18)
+keep only the ``zdot qd`` half and miss the half that comes from
+differentiating ``w x r`` while r grows at the rate ``z qd``.
+"""
+from ._jit import njit
+from .kinematics import (joint_trig, link_inertia, placement, revolute,
+                         stored_placement)
+from .layout import (C_HALF, C_ONE, C_ZERO, F_BASE, F_CONST, F_GRAV, F_TOOL,
+                     L_COM, L_MASS, W_F, W_N, WRENCH_BASE, WRENCH_NONE)
+from .spatial import cross, force_to_parent, frame_rot, matmul, rot, rot_t
+from .status import matrix_status
+
+
+@njit(cache=True, inline='always')
+def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
+              wrench_mode, ws, tau):
+    """
+    Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
+
+    ``joint_trig(links, frames, q, ws)`` must have been called for the same q.
+    A forward step per joint, base to tip, then a backward step per joint,
+    tip to base, as in the seed text (Pinocchio's RneaForwardStep and
+    RneaBackwardStep).  They are written inline, in one function: numba
+    passes arrays and tuples between functions at a cost (measured: 35%
+    more per call with the steps as functions, inlined or not).
+    Cost: about 250 flops per joint, O(n).  Every vector of link j is in
+    kernel frame j, whose z axis is joint j's axis through its origin.
+
+    Parameters
+    ----------
+    links : (n, L_WIDTH) array
+        Per-joint placement, mass, centre-of-mass and inertia parameters
+        (the ``L_*`` columns).
+    frames : (F_ROWS, 12) array
+        Base frame, tool frame, gravity and constants (the ``F_*`` rows).
+    qd, v, qdd : (n,) arrays
+        Joint velocity, reference velocity, acceleration.
+    wrench : (6,) array
+        [f; n] exerted by the end effector on its environment, moment about
+        the end-effector origin; base-frame axes when
+        ``wrench_mode == WRENCH_BASE``, end-effector axes when
+        ``WRENCH_EE``; ignored when ``WRENCH_NONE``.
+    gravity_on, velocity_on : bool
+        Skip the gravity or velocity-product terms altogether when False.
+    wrench_mode : int
+        ``WRENCH_NONE``, ``WRENCH_BASE`` or ``WRENCH_EE``.
+    ws : (n, W_WIDTH) array
+        Workspace: reads the trig columns ``joint_trig`` filled, overwrites
+        the other ``W_*`` columns.
+    tau : (n,) array
+        Output.
+
+    """
+    n = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    half = frames[F_CONST, C_HALF]
+    # Gravity enters as an upward acceleration of the base: a_0 = -g.
+    if gravity_on:
+        ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    else:
+        ae = (zero, zero, zero)
+    w = (zero, zero, zero)
+    r = (zero, zero, zero)
+    al = (zero, zero, zero)
+    Racc = frame_rot(frames, F_BASE)
+
+    # ---- forward steps, base to tip: the seed's eqs. (19)-(21) ----
+    # from link j-1's w, r, al, ae (frame j-1 axes) to link j's (frame j
+    # axes); link j's net force m a_c and moment about its com into ws
+    for j in range(n):
+        R, p = placement(links, frames, j, ws)
+        # acceleration of the new origin O_j, still in frame j-1 axes
+        t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
+        ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        if velocity_on:
+            t = cross(r[0], r[1], r[2], p[0], p[1], p[2])
+            t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
+            ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        # rotate everything into frame j
+        ae = rot_t(R, ae[0], ae[1], ae[2])
+        al = rot_t(R, al[0], al[1], al[2])
+        is_revolute = revolute(links, frames, j)
+        if velocity_on:
+            w = rot_t(R, w[0], w[1], w[2])
+            r = rot_t(R, r[0], r[1], r[2])
+            if is_revolute:
+                # alpha_j = R^T alpha_{j-1} + z qdd + (r_{j-1} x z) qd_j
+                al = (al[0] + r[1] * qd[j], al[1] - r[0] * qd[j],
+                      al[2] + qdd[j])
+                w = (w[0], w[1], w[2] + qd[j])
+                r = (r[0], r[1], r[2] + v[j])
+            else:
+                # the sliding joint: z qdd + Coriolis 2 w x z qd (v == qd)
+                ae = (ae[0] + r[1] * qd[j] + w[1] * v[j],
+                      ae[1] - r[0] * qd[j] - w[0] * v[j],
+                      ae[2] + qdd[j])
+        elif is_revolute:
+            al = (al[0], al[1], al[2] + qdd[j])
+        else:
+            ae = (ae[0], ae[1], ae[2] + qdd[j])
+        # acceleration of the centre of mass
+        c0 = links[j, L_COM]
+        c1 = links[j, L_COM + 1]
+        c2 = links[j, L_COM + 2]
+        t = cross(al[0], al[1], al[2], c0, c1, c2)
+        ac = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+        if velocity_on:
+            t = cross(r[0], r[1], r[2], c0, c1, c2)
+            t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
+            ac = (ac[0] + t[0], ac[1] + t[1], ac[2] + t[2])
+        m = links[j, L_MASS]
+        ws[j, W_F] = m * ac[0]
+        ws[j, W_F + 1] = m * ac[1]
+        ws[j, W_F + 2] = m * ac[2]
+        # Euler's equation about the com
+        Ic = link_inertia(links, j)
+        Ia = rot(Ic, al[0], al[1], al[2])
+        Nn = Ia
+        if velocity_on:
+            Ir = rot(Ic, r[0], r[1], r[2])
+            Iw = rot(Ic, w[0], w[1], w[2])
+            t = cross(w[0], w[1], w[2], Ir[0], Ir[1], Ir[2])
+            t2 = cross(r[0], r[1], r[2], Iw[0], Iw[1], Iw[2])
+            wr = cross(w[0], w[1], w[2], r[0], r[1], r[2])
+            t3 = rot(Ic, wr[0], wr[1], wr[2])
+            Nn = (Ia[0] + half * ((t[0] + t2[0]) + t3[0]),
+                  Ia[1] + half * ((t[1] + t2[1]) + t3[1]),
+                  Ia[2] + half * ((t[2] + t2[2]) + t3[2]))
+        ws[j, W_N] = Nn[0]
+        ws[j, W_N + 1] = Nn[1]
+        ws[j, W_N + 2] = Nn[2]
+        if wrench_mode == WRENCH_BASE:
+            Racc = matmul(Racc, R)
+
+    # ---- the wrench the tip exerts, as "f_{n+1}, tau_{n+1}" in frame n ----
+    f = (zero, zero, zero)
+    nm = (zero, zero, zero)
+    if wrench_mode != WRENCH_NONE:
+        e = tip_wrench(frames, wrench, wrench_mode, Racc)
+        nm = (e[0], e[1], e[2])
+        f = (e[3], e[4], e[5])
+
+    # ---- backward steps, tip to base: the force and moment balance ----
+    # f, nm hold the force and the moment (about O_j) that link j exerts on
+    # its child, in frame j axes.
+    for j in range(n - 1, -1, -1):
+        F0 = ws[j, W_F]
+        F1 = ws[j, W_F + 1]
+        F2 = ws[j, W_F + 2]
+        t = cross(links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2],
+                  F0, F1, F2)
+        nm = (nm[0] + t[0] + ws[j, W_N], nm[1] + t[1] + ws[j, W_N + 1],
+              nm[2] + t[2] + ws[j, W_N + 2])
+        f = (f[0] + F0, f[1] + F1, f[2] + F2)
+        # the joint takes the moment about (revolute) or the force along
+        # (prismatic) its axis z
+        if revolute(links, frames, j):
+            tau[j] = nm[2]
+        else:
+            tau[j] = f[2]
+        if j > 0:
+            R, p = stored_placement(ws, j)
+            f, nm = force_to_parent(R, p, f, nm)
+
+
+@njit(cache=True)
+def tip_wrench(frames, wrench, wrench_mode, Racc):
+    """
+    Return the wrench the tip exerts, at O_n in frame-n axes: [n; f].
+
+    ``Racc`` is the rotation of frame n in the base frame (used for
+    ``WRENCH_BASE``).  As the recursion's "f_{n+1}, tau_{n+1}".
+    """
+    Rt = frame_rot(frames, F_TOOL)
+    fe = (wrench[0], wrench[1], wrench[2])
+    ne = (wrench[3], wrench[4], wrench[5])
+    if wrench_mode == WRENCH_BASE:
+        Ree = matmul(Racc, Rt)
+        fe = rot_t(Ree, fe[0], fe[1], fe[2])
+        ne = rot_t(Ree, ne[0], ne[1], ne[2])
+    f = rot(Rt, fe[0], fe[1], fe[2])
+    nm = rot(Rt, ne[0], ne[1], ne[2])
+    t = cross(frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11],
+              f[0], f[1], f[2])
+    return (nm[0] + t[0], nm[1] + t[1], nm[2] + t[2], f[0], f[1], f[2])
+
+
+@njit(cache=True, inline='always')
+def gravity(links, frames, q, ws, tau):
+    """g(q) into tau: the recursion at rest with gravity only."""
+    unused = frames[0, :6]      # velocities and wrench: not read here
+    joint_trig(links, frames, q, ws)
+    # tau, zeroed, serves as qdd: the forward pass reads it before the
+    # backward pass writes the torques into it
+    for j in range(tau.shape[0]):
+        tau[j] = frames[F_CONST, C_ZERO]
+    recursion(links, frames, unused, unused, tau, unused, True, False,
+              WRENCH_NONE, ws, tau)
+
+
+@njit(cache=True)
+def unit_columns(links, frames, qd, coriolis, ws, scratch, M):
+    """
+    Columns of D (``coriolis`` False) or C(q, qd) from unit inputs.
+
+    D e_k = Y(q, 0, 0, e_k) and C e_k = Y(q, qd, e_k, 0), where Y is the
+    two-stream recursion; ``joint_trig`` must have been called for q.
+    ``scratch`` is a (3, n) array.  Cost: n recursions, O(n^2).
+    """
+    n = links.shape[0]
+    zero = scratch[0]
+    unit = scratch[1]
+    col = scratch[2]
+    for i in range(n):
+        zero[i] = frames[F_CONST, C_ZERO]
+        unit[i] = frames[F_CONST, C_ZERO]
+    for k in range(n):
+        unit[k] = frames[F_CONST, C_ONE]
+        if coriolis:
+            recursion(links, frames, qd, unit, zero, zero, False, True,
+                      WRENCH_NONE, ws, col)
+        else:
+            recursion(links, frames, zero, zero, unit, zero, False, False,
+                      WRENCH_NONE, ws, col)
+        unit[k] = frames[F_CONST, C_ZERO]
+        for i in range(n):
+            M[i, k] = col[i]
+
+
+@njit(cache=True)
+def mass_matrix_columns(links, frames, q, ws, scratch, D):
+    """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k)."""
+    n = links.shape[0]
+    half = frames[F_CONST, C_HALF]
+    joint_trig(links, frames, q, ws)
+    unit_columns(links, frames, q, False, ws, scratch, D)
+    # D is symmetric in exact arithmetic; make it so to the last bit.
+    for i in range(n):
+        for k in range(i + 1, n):
+            avg = half * (D[i, k] + D[k, i])
+            D[i, k] = avg
+            D[k, i] = avg
+    return matrix_status(D)
+
+
+@njit(cache=True)
+def coriolis_matrix_columns(links, frames, q, qd, ws, scratch, C):
+    """Christoffel C(q, qd) column by column: C e_k = Y(q, qd, e_k, 0)."""
+    joint_trig(links, frames, q, ws)
+    unit_columns(links, frames, qd, True, ws, scratch, C)
+    return matrix_status(C)
