@@ -16,8 +16,12 @@
 Pure numpy/numba core: robot model, kinematics and dynamics (no ROS).
 
 See :mod:`newton_euler_ros.core.dynamics` for the functions, one per term
-of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``, and
-:mod:`newton_euler_ros.core.float32` for the same in single precision.
+of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``,
+:mod:`newton_euler_ros.core.float32` for the same in single precision,
+:mod:`newton_euler_ros.core.regressor` for the torque regressor
+(``tau = Y pi``), :mod:`newton_euler_ros.core.drives` for joint friction
+and rotor inertia, and :mod:`newton_euler_ros.core.observer` for the
+momentum observer.
 """
 from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        end_effector_pose, forward_dynamics,
@@ -26,17 +30,23 @@ from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        inverse_dynamics_batch, jacobian, link_poses,
                        mass_matrix, mass_matrix_batch, mass_matrix_condition,
                        velocity_products, wrench_torques)
+from .drives import Drives
 from .effects import EffectDynamics, Effects
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
 from .float32 import Float32Dynamics
 from .model import make_model, pose_matrix, RobotModel, rpy_matrix
+from .observer import MomentumObserver, observe_recording
+from .regressor import regressor, regressor_batch
 from .robot_file import (bundled_robots, inspect_robot, load_robot,
                          robot_from_dict, RobotFileWarning)
+from .urdf import load_urdf, model_to_urdf
 from .workspace import Workspace
 
 __all__ = [
-    'DynamicsInputError', 'EffectDynamics', 'Effects', 'Float32Dynamics',
+    'Drives', 'DynamicsInputError', 'EffectDynamics', 'Effects',
+    'Float32Dynamics', 'MomentumObserver', 'load_urdf', 'model_to_urdf',
+    'observe_recording', 'regressor', 'regressor_batch',
     'NewtonEulerError', 'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
     'RobotModel', 'Workspace', 'bundled_robots', 'coriolis_matrix',
     'coriolis_matrix_batch', 'end_effector_pose', 'forward_dynamics',
