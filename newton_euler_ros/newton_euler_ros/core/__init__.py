@@ -23,6 +23,7 @@ of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``,
 and rotor inertia, and :mod:`newton_euler_ros.core.observer` for the
 momentum observer.
 """
+from .drives import Drives
 from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        end_effector_pose, forward_dynamics,
                        forward_dynamics_batch, gravity_torques,
@@ -30,7 +31,6 @@ from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        inverse_dynamics_batch, jacobian, link_poses,
                        mass_matrix, mass_matrix_batch, mass_matrix_condition,
                        velocity_products, wrench_torques)
-from .drives import Drives
 from .effects import EffectDynamics, Effects
 from .errors import (DynamicsInputError, NewtonEulerError,
                      NotPositiveDefiniteError, RobotFileError)
