@@ -38,6 +38,7 @@ import sys
 import numpy as np
 
 from .cli_identify import register as register_identify
+from .cli_loop import register as register_loop
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError)
 from .core.robot_file import bundled_robots, Note, read_text, to_number
@@ -407,6 +408,7 @@ def build_parser():
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
     register_identify(sub)
+    register_loop(sub)
     return parser
 
 
