@@ -5,6 +5,7 @@
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
+#   make bench-identify  identification time and memory (1 and 30 min bags)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
 #   make accuracy  accuracy-vs-time report -> docs/accuracy-vs-time.md (+ peers)
 #   make accuracy-quick  the same in under a minute, into build/accuracy-quick
@@ -27,8 +28,8 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
 
-.PHONY: setup test demo demo-pick bench latency peers accuracy accuracy-quick \
-	colcon-check clean
+.PHONY: setup test demo demo-pick bench bench-identify latency peers accuracy \
+	accuracy-quick colcon-check clean
 
 setup:
 	@bash scripts/setup_env.sh
@@ -49,6 +50,11 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_trajectory
 	$(PY) -m newton_euler_tools.bench_scaling
 	$(PY) -m newton_euler_tools.bench_regressor
+
+# identification: 40 s recording time; 1 and 30 min time and peak memory
+# (about 10 minutes: writing and reading the 30 min bag dominates)
+bench-identify: setup
+	$(PY) -m newton_euler_tools.bench_identify
 
 latency: setup
 	$(PY) -m newton_euler_tools.latency_bench

@@ -35,8 +35,9 @@ What real recordings need, and what this module does about it:
   twice) and samples whose stamp goes backwards are dropped and counted.
 - Messages without an effort (or position) for the chain are dropped and
   counted; velocity may be absent: ``qd`` is then None (differentiate).
-- The bag is read in chunks (:func:`iter_joint_states`), so a long
-  recording never has to be in memory at once.
+- The bag is read in chunks (:func:`iter_joint_states`), and the reader
+  over windows of recording time, so a long recording never has to be in
+  memory at once.
 
 Every problem with the file raises :class:`BagError` with one line naming
 the bag and what is wrong (missing, corrupt or truncated, no such topic,
@@ -54,6 +55,8 @@ JOINT_STATE = 'sensor_msgs/msg/JointState'
 # Fewer kept samples than this is "too short" to filter and fit.
 MIN_SAMPLES = 50
 DEFAULT_CHUNK = 65536
+# recording time read per reader call (see _windowed)
+WINDOW_NS = 30 * 1_000_000_000
 
 
 class BagError(NewtonEulerError, ValueError):
@@ -199,7 +202,7 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
         use_logtime = None
         missing_seen = None
         t0 = None
-        stream = reader.messages(connections=conns)
+        stream = _windowed(reader, conns)
         while True:
             try:
                 item = next(stream)
@@ -271,6 +274,22 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
             reader.close()
         except Exception:  # noqa: BLE001, S110 (already failing)
             pass
+
+
+def _windowed(reader, conns, window_ns=WINDOW_NS):
+    """
+    Messages of ``conns`` in recording-time windows, in order.
+
+    One ``messages()`` call over a whole MCAP file primes a reader for
+    every chunk at once (memory grows with the recording); consecutive
+    windows keep only the chunks of one window open.
+    """
+    start, end = reader.start_time, reader.end_time
+    t = start
+    while t < end:
+        yield from reader.messages(connections=conns, start=t,
+                                   stop=min(t + window_ns, end))
+        t += window_ns
 
 
 def _same(a, b):

@@ -112,33 +112,49 @@ def _set_inertial(link_el, pi_own):
     index = list(link_el).index(old) if old is not None else 0
     if old is not None:
         link_el.remove(old)
+    # indented like the element it replaces
+    inner = (old.text if old is not None and old.text else '\n      ')
+    last = (old[-1].tail if old is not None and len(old) and old[-1].tail
+            else '\n    ')
     el = ET.Element('inertial')
-    el.text = '\n      '
-    el.tail = '\n    '
+    el.text = inner
+    el.tail = old.tail if old is not None else '\n    '
     o = ET.SubElement(el, 'origin', xyz=_fmt(c), rpy='0 0 0')
-    o.tail = '\n      '
+    o.tail = inner
     ms = ET.SubElement(el, 'mass', value=repr(float(m)))
-    ms.tail = '\n      '
+    ms.tail = inner
     i = ET.SubElement(el, 'inertia', ixx=repr(float(Ic[0, 0])),
                       ixy=repr(float(Ic[0, 1])), ixz=repr(float(Ic[0, 2])),
                       iyy=repr(float(Ic[1, 1])), iyz=repr(float(Ic[1, 2])),
                       izz=repr(float(Ic[2, 2])))
-    i.tail = '\n    '
+    i.tail = last
     link_el.insert(index, el)
+
+
+def _append(parent, tag):
+    """Append a child element, indented like its siblings."""
+    kids = list(parent)
+    el = ET.SubElement(parent, tag)
+    if kids:
+        el.tail = kids[-1].tail
+        kids[-1].tail = (kids[-2].tail if len(kids) > 1
+                         else parent.text or '\n')
+    else:
+        parent.text = '\n'
+        el.tail = '\n'
+    return el
 
 
 def _set_drive(joint_el, drives, j):
     dyn = joint_el.find('dynamics')
     if dyn is None:
-        dyn = ET.SubElement(joint_el, 'dynamics')
-        dyn.tail = '\n  '
+        dyn = _append(joint_el, 'dynamics')
     dyn.set('damping', repr(float(drives.viscous[j])))
     dyn.set('friction', repr(float(drives.coulomb[j])))
     tag = f'{{{DRIVES_NS}}}drive'
     ext = joint_el.find(tag)
     if ext is None:
-        ext = ET.SubElement(joint_el, tag)
-        ext.tail = '\n  '
+        ext = _append(joint_el, tag)
     ext.set('armature', repr(float(drives.armature[j])))
     ext.set('offset', repr(float(drives.offset[j])))
     ext.set('coulomb_width', repr(float(drives.coulomb_width[j])))
