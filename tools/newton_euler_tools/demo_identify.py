@@ -13,8 +13,9 @@
 # limitations under the License.
 
 """
-The identification loop end to end, over DDS: excite, record, identify,
-track again, pick up a payload and estimate it.
+The identification loop end to end, over DDS.
+
+Excite, record, identify, track again, pick up a payload and estimate it.
 
     python -m newton_euler_tools.demo_identify [--out DIR] [--quick]
 
@@ -94,7 +95,7 @@ def newton_euler(*args, log=None):
 
 def real_plant_urdf(text, links, seed):
     """
-    The plant: perturbed inertials, ending at the tip link.
+    Return the plant's URDF: perturbed inertials, ending at the tip link.
 
     The hand and fingers (fixed at zero, as the node lumps them) become one
     inertial of ``panda_link8``, so that the simulator's scene, which takes
@@ -145,7 +146,7 @@ def _chain_of_text(text):
 
 
 def write_scene(path, robot_file, duration):
-    """The plant's scene: the real URDF, friction and rotor inertia."""
+    """Write the plant's scene: the real URDF, friction, rotor inertia."""
     lines = [
         '# written by newton_euler_tools.demo_identify: the "real" Panda',
         'name: panda_real',
@@ -295,7 +296,7 @@ def load_segment(path):
 
 
 def true_torques(truth_model, segment, payload=None):
-    """The plant's torque along the plan: rigid body + friction + rotor."""
+    """Return the plant's torque along the plan (body, friction, rotor)."""
     from newton_euler_ros.core import inverse_dynamics_batch
     from newton_euler_ros.core.model import inertia_matrix, with_payload
     model = truth_model
@@ -339,7 +340,7 @@ def plot(runs, segment, truth, out):
             ax.plot(t, r['ff'][:, j] - truth[label][:, j], lw=0.8,
                     label=label)
         ax.set_ylabel(f'joint {j + 1}\nN m', fontsize=8)
-    axes[0].set_title('feedforward effort minus the plant\'s true torque')
+    axes[0].set_title('feedforward effort minus the true torque')
     axes[0].legend(fontsize=7, ncol=2)
     axes[-1].set_xlabel('time along the plan (s)')
     fig.tight_layout()
@@ -401,10 +402,6 @@ def main(argv=None):
         newton_euler('identify', published, bag1, '--base', BASE, '--tip',
                      TIP, '-o', identified,
                      log=os.path.join(out, 'identify.txt'))
-        newton_euler('replay', identified, bag1, '--base', BASE, '--tip',
-                     TIP, '--csv', os.path.join(out, 'replay.csv'),
-                     '--plot', os.path.join(out, 'replay.png'),
-                     log=os.path.join(out, 'replay.txt'))
         print('[4/6] run with the identified URDF + drive compensation',
               flush=True)
         key = 'identified URDF + drive compensation'
@@ -422,8 +419,6 @@ def main(argv=None):
         estimate = json.loads(newton_euler(
             'payload', identified, bag2, '--base', BASE, '--tip', TIP,
             '--json', log=os.path.join(out, 'payload.json')))
-        newton_euler('payload', identified, bag2, '--base', BASE, '--tip',
-                     TIP, log=os.path.join(out, 'payload.txt'))
         print('[6/6] payload estimate given to the node', flush=True)
         key = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
         runs[key] = run('payload_told', scene, identified, segment, duration,
@@ -471,7 +466,7 @@ def main(argv=None):
         f'trajectory runs with the identified URDF and '
         f'`drives.compensate:=true`; then the plant picks up '
         f'{PAYLOAD["mass"]:g} kg, `newton-euler payload` estimates it from '
-        f'a recording, and the estimate goes to the node\'s `payload.*`.',
+        f'a recording, and the estimate goes to the `payload.*` of the node.',
         '',
         '| run | feedforward torque error, RMS (N m) | relative to the true '
         'torque | tracking error, RMS (mrad) | max (mrad) |',
@@ -479,7 +474,7 @@ def main(argv=None):
         *rows,
         '',
         'Feedforward torque error: the efforts the node filled in, against '
-        'the plant\'s true torque along the plan (its real inertials, '
+        'the true torque of the plant along the plan (its real inertials, '
         'friction and rotor inertia, the payload when held). Tracking error: '
         'the joint positions against the plan.',
         '',
@@ -490,9 +485,9 @@ def main(argv=None):
         f'[{", ".join(f"{1000 * v:.1f}" for v in PAYLOAD["com"])}])',
         '',
         'Files: `excitation.json`, `recording/` and `payload_recording/` '
-        '(rosbag2), `panda_identified.urdf`, the commands\' output '
-        '(`excite.txt`, `identify.txt`, `replay.txt`, `payload.txt`), '
-        '`replay.png`, the nodes\' logs in `logs/`.',
+        '(rosbag2), `panda_identified.urdf`, the output of the commands '
+        '(`excite.txt`, `identify.txt`, `payload.json`), the logs of the '
+        'nodes in `logs/`.',
         '',
         '![tracking error](tracking.png)',
         '',
