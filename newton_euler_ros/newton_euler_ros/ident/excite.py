@@ -304,15 +304,19 @@ def check_feasible(model, limits, start, period, harmonics):
                 f'start position of {names[j]} ({start[j]:g}) is within '
                 f'{min(down[j], up[j]):.3g} of its limit (margin included): '
                 f'choose a start nearer the middle')
-        if swing[j] < need[j]:
-            t_min = 2 * math.pi * max(need[j] / vmax[j],
-                                      math.sqrt(need[j] / amax[j]))
-            raise ExcitationError(
-                f'period {period:g} s is too short for the velocity and '
-                f'acceleration limits of {names[j]} ({vmax[j]:.3g} rad/s, '
-                f'{amax[j]:.3g} rad/s^2 with the margin): it could swing '
-                f'only +-{swing[j]:.3g}; use --period {math.ceil(t_min * 10) / 10:g} '
-                f'or more')
+    short = np.flatnonzero(swing < need)
+    if short.size:
+        # the shortest period every joint can live with
+        t_min = max(2 * math.pi * max(need[k] / vmax[k],
+                                      math.sqrt(need[k] / amax[k]))
+                    for k in range(model.n))
+        j = int(short[np.argmin(swing[short] / need[short])])
+        raise ExcitationError(
+            f'period {period:g} s is too short for the velocity and '
+            f'acceleration limits of {names[j]} ({vmax[j]:.3g} rad/s, '
+            f'{amax[j]:.3g} rad/s^2 with the margin): it could swing '
+            f'only +-{swing[j]:.3g}; use --period '
+            f'{math.ceil(t_min * 10) / 10:g} or more')
 
 
 def excite(model, period=10.0, harmonics=5, seed=0, start=None,

@@ -41,8 +41,9 @@ How well the recording determines each quantity: the covariance
 sigma^2 (A^T A)^-1 of the weighted problem, propagated to the mass, the
 centre of mass and the inertia about it.  A quantity is *undetermined*
 when its standard error exceeds ``MASS_TOL`` (relative) / ``COM_TOL`` (m) /
-``INERTIA_TOL`` (relative to the largest determined inertia, or
-``INERTIA_ABS``) — a motion that never rotates the wrist cannot tell the
+``INERTIA_TOL`` (relative to the largest inertia term, or
+``INERTIA_ABS``), the uncertainty being what a change of the parameters
+as large as the torque residual could hide — a motion that never rotates the wrist cannot tell the
 inertia, and a payload that is not there has no centre of mass.
 """
 from dataclasses import dataclass, field
@@ -56,6 +57,7 @@ from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
 
 MASS_TOL = 0.05           # relative standard error of the mass
 MASS_ABS = 0.02           # kg: below this the payload is "no payload"
+MASS_TOL_ABS = 0.05       # kg: a mass error this small is determined
 COM_TOL = 0.01            # m, standard error of each coordinate
 INERTIA_TOL = 0.3         # relative standard error
 INERTIA_ABS = 2e-3        # kg m^2
@@ -116,9 +118,9 @@ class PayloadEstimate:
             out.append(f'the mass is undetermined (standard error '
                        f'{self.mass_std:.3g} kg)')
         if not self.determined['present']:
-            out.append('no payload: the mass is below '
-                       f'{MASS_ABS:g} kg; centre of mass and inertia are '
-                       f'meaningless')
+            out.append(f'no payload: the mass is below {MASS_ABS:g} kg or '
+                       f'twice its uncertainty; centre of mass and inertia '
+                       f'are meaningless')
             return out
         bad = [a for a, ok in zip('xyz', self.determined['com']) if not ok]
         if bad:
@@ -144,7 +146,8 @@ class PayloadEstimate:
                          f'{self.mass:.3g} kg, +-{self.mass_std:.2g})')
         if not d['present']:
             lines.append(f'  no payload: the mass is below {MASS_ABS:g} kg '
-                         f'(centre of mass and inertia not reported)')
+                         f'or twice its uncertainty (centre of mass and '
+                         f'inertia not reported)')
         else:
             cells = []
             for a in range(3):
@@ -298,8 +301,9 @@ def _uncertainty(m, c, Ic, pi, cov):
     mass_std = float(std[0])
     com_std = std[1:4]
     in_std = std[4:]
-    present = m >= MASS_ABS and mass_std < 0.5 * m
-    mass_ok = mass_std <= max(MASS_TOL * m, 0.5 * MASS_ABS)
+    # a payload is there when its mass stands out of its uncertainty
+    present = m >= max(MASS_ABS, 2.0 * mass_std)
+    mass_ok = mass_std <= max(MASS_TOL * m, MASS_TOL_ABS)
     com_ok = [bool(present and com_std[a] <= COM_TOL) for a in range(3)]
     ref = max([abs(Ic[a, b]) for a, b in INERTIA_KEYS] + [0.0])
     in_tol = max(INERTIA_TOL * ref, INERTIA_ABS)

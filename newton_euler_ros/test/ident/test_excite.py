@@ -165,3 +165,25 @@ def test_cli_missing_urdf_and_directory(tmp_path):
     code, _, err = run_cli('excite', panda_path(), '--base', BASE, '--tip',
                            TIP, '-o', str(tmp_path / 'nodir' / 'x.json'))
     assert code == 2 and 'nodir' in err and len(err.splitlines()) == 1
+
+
+def test_trajectory_efforts_add_the_drive_terms(panda, excitation):
+    # what the node fills in on ~/trajectory_in with drives.compensate on
+    from newton_euler_ros.core import inverse_dynamics_batch
+    from newton_euler_ros.core.drives import Drives
+    from newton_euler_ros.core.trajectory import trajectory_efforts
+    traj = trajectory_json(excitation, rate=20.0)
+    names = list(reversed(traj['joint_names']))
+    points = [{'time_from_start': p['time_from_start'],
+               **{k: list(reversed(p[k])) for k in
+                  ('positions', 'velocities', 'accelerations')}}
+              for p in traj['points']]
+    rng = np.random.default_rng(3)
+    drives = Drives.from_parameters(rng.uniform(0.05, 0.5, 28))
+    got = trajectory_efforts(panda, names, points, drives=drives)
+    Q, QD, QDD = (np.array([p[k] for p in traj['points']]) for k in
+                  ('positions', 'velocities', 'accelerations'))
+    want = (inverse_dynamics_batch(panda, Q, QD, QDD)
+            + drives.torques(QD, QDD))[:, ::-1]
+    np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-9)
+    assert not np.allclose(got, trajectory_efforts(panda, names, points))
