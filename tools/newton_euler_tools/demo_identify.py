@@ -365,7 +365,7 @@ def main(argv=None):
     log_dir = os.path.join(out, 'logs')
     os.makedirs(log_dir, exist_ok=True)
     period, periods, harmonics, budget = ((5.0, 1, 3, 4.0) if args.quick
-                                          else (8.0, 2, 4, 15.0))
+                                          else (6.0, 2, 4, 10.0))
     try:
         published = os.path.join(out, 'panda_published.urdf')
         shutil.copyfile(panda_path(), published)
