@@ -24,7 +24,7 @@ Identification: time for a 40 s recording; time and memory against length.
    at ``--rate`` (default 1000 Hz, what real arms publish), efforts from
    the nominal model plus drive terms and noise: each identified in its
    own process, which reports its time and peak resident memory
-   (``ru_maxrss``).  The fit accumulates a (14n + 1)^2 R factor per joint,
+   (VmHWM).  The fit accumulates a (14n + 1)^2 R factor per joint,
    so memory must not grow with the recording's length; the time does
    (reading and deserialising the bag dominates).
 """
@@ -73,6 +73,24 @@ def synthetic_bag(path, seconds, rate, seed=0):
     write_joint_states(path, stamps, model.joint_names, q, qd, tau)
 
 
+def peak_rss_mb():
+    """
+    Peak resident memory of this process, MB.
+
+    VmHWM of /proc/self/status: ``ru_maxrss`` would not do, Linux carries
+    it over fork and exec from the parent (the bench's parent holds the
+    long recording it has just written).
+    """
+    try:
+        with open('/proc/self/status', encoding='ascii') as f:
+            for line in f:
+                if line.startswith('VmHWM:'):
+                    return int(line.split()[1]) / 1024.0
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
 def identify_once(bag):
     """Identify the Panda from ``bag``; return seconds and peak RSS (MB)."""
     from newton_euler_ros.ident.fit import identify
@@ -82,7 +100,7 @@ def identify_once(bag):
     start = time.perf_counter()
     result = identify(model, bag, urdf_text=text)
     seconds = time.perf_counter() - start
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    peak = peak_rss_mb()
     rel = result.fit_stats['identified'][1]
     return {'seconds': seconds, 'peak_mb': peak,
             'samples': int(result.info['samples']),

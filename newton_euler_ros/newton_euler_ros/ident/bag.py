@@ -353,6 +353,17 @@ def read_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
         notes=last.notes)
 
 
+def recording_seconds(path):
+    """Return the recording's length in seconds (log time), or BagError."""
+    reader = _open(path)
+    try:
+        return reader.duration * 1e-9
+    except Exception:  # noqa: BLE001 (an empty bag has no times)
+        return 0.0
+    finally:
+        reader.close()
+
+
 def write_joint_states(path, stamps_ns, names, q, qd, effort,
                        topic=DEFAULT_TOPIC, storage='mcap',
                        logtimes_ns=None):

@@ -29,8 +29,8 @@ the torques linearly, tau = Y theta (``core.regressor`` with
    [Y_j | y_j] over the chunks (:class:`Reduced`): (14n + 1)^2 numbers
    whatever the recording's length, and from it exactly the residual
    ||y_j - Y_j theta||^2 of any theta.  Time blocks of ``BLOCK_S`` seconds
-   alternate between a training and a held-out part (one in
-   ``HOLDOUT_EVERY``).
+   (shorter for a short recording) alternate between a training and a
+   held-out part (one in ``HOLDOUT_EVERY``).
 3. Weights: each joint's rows by 1 / sigma_j, sigma_j the RMS residual of
    an unconstrained least-squares fit on the training part (weighted least
    squares, Gautier & Poignet): small wrist torques count as much as the
@@ -60,7 +60,8 @@ import time
 
 import numpy as np
 
-from .bag import BagError, DEFAULT_TOPIC, iter_joint_states
+from .bag import (BagError, DEFAULT_TOPIC, iter_joint_states,
+                  recording_seconds)
 from .base import base_parameters, structural_base
 from .signals import default_cutoff, edge_samples, prepare, sample_rate
 from ..core.drives import DEFAULT_COULOMB_WIDTH, Drives, model_drives
@@ -201,8 +202,13 @@ def accumulate(model, path, topic=DEFAULT_TOPIC, coulomb_width=None,
     """
     Reduce a recording: return (train, held_out or None, info dict).
 
-    With ``split=False`` every block goes to ``train``.
+    With ``split=False`` every block goes to ``train``.  Blocks are
+    ``BLOCK_S`` long, shorter for a recording under ten blocks (down to
+    half a second), so that even a short one has a held-out part.
     """
+    block_s = BLOCK_S
+    if split:
+        block_s = min(BLOCK_S, max(0.5, recording_seconds(path) / 10.0))
     eps = DEFAULT_COULOMB_WIDTH if coulomb_width is None else coulomb_width
     p = model.n * (N_INERTIAL + N_DRIVE)
     train = Reduced(model.n, p)
@@ -229,7 +235,7 @@ def accumulate(model, path, topic=DEFAULT_TOPIC, coulomb_width=None,
             if held is None:
                 train.add(Y, tau)
                 continue
-            block = np.floor((piece.t[sel] - t_first) / BLOCK_S)
+            block = np.floor((piece.t[sel] - t_first) / block_s)
             out = (block % HOLDOUT_EVERY) == HOLDOUT_EVERY - 1
             train.add(Y[~out], tau[~out])
             held.add(Y[out], tau[out])
