@@ -173,7 +173,10 @@ def cmd_identify(args):
                           coulomb_width=args.coulomb_width,
                           cutoff=args.cutoff, urdf_text=text)
     except (NewtonEulerError, ValueError) as exc:
-        _fail(str(exc))
+        text = str(exc)
+        named = any(text.startswith(str(p)) for p in (args.bag,
+                                                      args.validate) if p)
+        _fail(text if named else f'{args.bag}: {text}')
     info = result.info
     names = model.joint_names
     print(f'recording {args.bag}: {info["samples"]} samples over '
