@@ -4,6 +4,7 @@
 #                and tools/test (pytest.ini)
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
+#   make demo-identify  excite, record, identify, payload; out/demo_identify/
 #   make bench   run the benchmarks (peers side by side; cost per effect)
 #   make bench-identify  identification time and memory (1 and 30 min bags)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
@@ -28,7 +29,8 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
 
-.PHONY: setup test demo demo-pick bench bench-identify latency peers accuracy \
+.PHONY: setup test demo demo-pick demo-identify bench bench-identify latency \
+	peers accuracy \
 	accuracy-quick colcon-check clean
 
 setup:
@@ -42,6 +44,9 @@ demo: setup
 
 demo-pick: setup
 	$(PY) -m newton_euler_tools.demo_pick
+
+demo-identify: setup
+	$(PY) -m newton_euler_tools.demo_identify
 
 bench: setup
 	$(PY) -m newton_euler_tools.bench

@@ -38,6 +38,7 @@ import sys
 import numpy as np
 
 from .cli_identify import register as register_identify
+from .cli_loop import register as register_loop
 from .cli_observe import register as register_observe
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
@@ -417,6 +418,7 @@ def build_parser():
     rob.set_defaults(func=cmd_robots)
     register_identify(sub)
     register_observe(sub)
+    register_loop(sub)
     return parser
 
 

@@ -221,19 +221,22 @@ def trajectory_arrays(model, joint_names, points, where=''):
 
 
 def trajectory_efforts(model, joint_names, points, wrench=None,
-                       wrench_frame='base', where='', ws=None):
+                       wrench_frame='base', where='', ws=None, drives=None):
     """
     Efforts (m, n) at every point, in the trajectory's joint order.
 
     tau = D qdd + C qd + g (+ J^T F_e for a ``wrench`` held along the whole
-    trajectory), one batched call; raises :class:`TrajectoryError` for a
-    bad trajectory (one line naming the point and the field).
+    trajectory, + the drive terms of ``drives``, a ``core.drives.Drives``),
+    one batched call; raises :class:`TrajectoryError` for a bad trajectory
+    (one line naming the point and the field).
     """
     _, Q, QD, QDD = trajectory_arrays(model, joint_names, points, where)
     W = None
     if wrench is not None:
         W = np.tile(np.asarray(wrench, dtype=np.float64), (Q.shape[0], 1))
     tau = inverse_dynamics_batch(model, Q, QD, QDD, W, wrench_frame, ws=ws)
+    if drives is not None:
+        tau = tau + drives.torques(QD, QDD)
     cols = _column_map(model, joint_names, where)
     out = np.empty_like(tau)
     out[:, cols] = tau

@@ -449,7 +449,8 @@ class InverseDynamicsNode(Node):
                         if self.params['trajectory.include_wrench']
                         else (None, 'base'))
             efforts = trajectory_efforts(ff.model, msg.joint_names, points,
-                                         w, frame, 'trajectory: ', ff.ws)
+                                         w, frame, 'trajectory: ', ff.ws,
+                                         drives=ff.drives)
         except NewtonEulerError as exc:
             self._reject('trajectory', InputRejected('malformed', str(exc)))
             return

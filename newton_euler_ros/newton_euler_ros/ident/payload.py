@@ -1,0 +1,318 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Estimate a payload fixed to the tip from a recording.
+
+The arm's model (identified inertials and drive terms) predicts what the
+drives need without the payload; the rest of the measured effort is the
+payload's:
+
+    effort - tau_arm(q, qd, qdd) - tau_drives(qd, qdd) = Y_tip T pi_p
+
+``Y_tip`` is the last link's ten columns of the torque regressor
+(``core.regressor``: parameters about the last link frame's origin, in its
+axes) and ``T`` the linear map of a body's ten parameters from the tip
+frame to the last link frame (the pseudo-inertia J transforms as
+X J X^T with X the 4x4 pose of the tip in the link frame, which is the
+model's ``tool``).  ``pi_p`` = (m, m c, I about the tip origin) in the tip
+frame.
+
+The samples come from the identification pipeline (``fit.prepared_windows``:
+resampled, zero-phase filtered, same filter on the effort), reduced to a
+10 x 10 R factor per joint.  Each joint is weighted by 1 / its residual RMS
+(unconstrained fit first), and the fit is a small semidefinite program:
+the payload's pseudo-inertia positive semi-definite (so m >= 0 and the
+inertia physical), with a tiny pull toward zero so that directions the
+motion does not excite come out at zero instead of at noise.
+
+How well the recording determines each quantity: the covariance
+sigma^2 (A^T A)^-1 of the weighted problem, propagated to the mass, the
+centre of mass and the inertia about it.  A quantity is *undetermined*
+when its standard error exceeds ``MASS_TOL`` (relative) / ``COM_TOL`` (m) /
+``INERTIA_TOL`` (relative to the largest inertia term, or
+``INERTIA_ABS``), the uncertainty being what a change of the parameters
+as large as the torque residual could hide — a motion that never rotates the wrist cannot tell the
+inertia, and a payload that is not there has no centre of mass.
+"""
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .fit import _decimation, IdentificationError, prepared_windows, Reduced
+from ..core.drives import model_drives
+from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
+                              regressor_batch)
+
+MASS_TOL = 0.05           # relative standard error of the mass
+MASS_ABS = 0.02           # kg: below this the payload is "no payload"
+MASS_TOL_ABS = 0.05       # kg: a mass error this small is determined
+COM_TOL = 0.01            # m, standard error of each coordinate
+INERTIA_TOL = 0.3         # relative standard error
+INERTIA_ABS = 2e-3        # kg m^2
+PRIOR_WEIGHT = 1e-6       # pull toward zero, of the data's scale
+STATE_CHUNK = 4096
+INERTIA_KEYS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
+INERTIA_NAMES = ('Ixx', 'Iyy', 'Izz', 'Ixy', 'Iyz', 'Ixz')
+
+
+def _pi_from_pseudo(J):
+    Sigma = J[:3, :3]
+    I = np.trace(Sigma) * np.eye(3) - Sigma  # noqa: E741
+    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], I[0, 0], I[0, 1],
+                     I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
+def tip_to_link(tool):
+    """10 x 10 map of a body's parameters from the tip to the link frame."""
+    X = np.asarray(tool, dtype=np.float64)
+    T = np.zeros((N_INERTIAL, N_INERTIAL))
+    for k in range(N_INERTIAL):
+        e = np.zeros(N_INERTIAL)
+        e[k] = 1.0
+        T[:, k] = _pi_from_pseudo(X @ pseudo_inertia(e) @ X.T)
+    return T
+
+
+@dataclass
+class PayloadEstimate:
+    """The estimate, its standard errors and what is determined."""
+
+    mass: float
+    com: np.ndarray           # tip frame, m
+    inertia: np.ndarray       # 3x3 about the com, tip frame
+    pi: np.ndarray            # 10 parameters about the tip origin
+    mass_std: float
+    com_std: np.ndarray
+    inertia_std: np.ndarray   # 6, in INERTIA_NAMES order
+    determined: dict = field(default_factory=dict)
+    samples: int = 0
+    duration: float = 0.0
+    residual_before: np.ndarray = None   # per joint RMS, arm model alone
+    residual_after: np.ndarray = None    # with the payload
+    joint_names: list = field(default_factory=list)
+
+    def parameters(self):
+        """Return the node's payload.* parameters as a JSON-ready dict."""
+        I = self.inertia  # noqa: E741
+        return {'payload.mass': float(self.mass),
+                'payload.com': [float(x) for x in self.com],
+                'payload.inertia': [float(I[a, b]) for a, b in
+                                    INERTIA_KEYS]}
+
+    def undetermined_lines(self):
+        """One line per quantity the recording does not determine."""
+        out = []
+        if not self.determined['mass']:
+            out.append(f'the mass is undetermined (standard error '
+                       f'{self.mass_std:.3g} kg)')
+        if not self.determined['present']:
+            out.append(f'no payload: the mass is below {MASS_ABS:g} kg or '
+                       f'twice its uncertainty; centre of mass and inertia '
+                       f'are meaningless')
+            return out
+        bad = [a for a, ok in zip('xyz', self.determined['com']) if not ok]
+        if bad:
+            out.append(f'centre of mass {", ".join(bad)} undetermined by '
+                       f'this motion (the JSON value is only a guess)')
+        bad = [n for n, ok in zip(INERTIA_NAMES, self.determined['inertia'])
+               if not ok]
+        if bad:
+            out.append(f'inertia {", ".join(bad)} undetermined by this '
+                       f'motion (rotate the wrist about more axes)')
+        return out
+
+    def summary_lines(self, tip):
+        """Return a readable summary (``payload`` without --json)."""
+        d = self.determined
+        lines = [f'payload fixed to {tip}, from {self.samples} samples over '
+                 f'{self.duration:.1f} s']
+        if d['mass']:
+            lines.append(f'  mass         {self.mass:.4g} kg  '
+                         f'(+-{self.mass_std:.2g})')
+        else:
+            lines.append(f'  mass         undetermined (estimate '
+                         f'{self.mass:.3g} kg, +-{self.mass_std:.2g})')
+        if not d['present']:
+            lines.append(f'  no payload: the mass is below {MASS_ABS:g} kg '
+                         f'or twice its uncertainty (centre of mass and '
+                         f'inertia not reported)')
+        else:
+            cells = []
+            for a in range(3):
+                cells.append(f'{1000 * self.com[a]:.1f} mm (+-'
+                             f'{1000 * self.com_std[a]:.2g})'
+                             if d['com'][a] else 'undetermined')
+            lines.append(f'  com ({tip} frame)  x {cells[0]}, y {cells[1]}, '
+                         f'z {cells[2]}')
+            cells = []
+            for k, (a, b) in enumerate(INERTIA_KEYS):
+                cells.append(f'{INERTIA_NAMES[k]} '
+                             + (f'{self.inertia[a, b]:.3g}'
+                                if d['inertia'][k] else 'undetermined'))
+            lines.append('  inertia about the com (kg m^2): '
+                         + ', '.join(cells))
+        lines.append('torque residual per joint, RMS N m (arm model alone -> '
+                     'with the payload):')
+        for j, name in enumerate(self.joint_names):
+            lines.append(f'  {name:<16}{self.residual_before[j]:>10.4g} -> '
+                         f'{self.residual_after[j]:.4g}')
+        for line in self.undetermined_lines():
+            lines.append(f'note: {line}')
+        return lines
+
+
+def _solve_sdp(Rw, zw, prior):
+    import cvxpy as cp
+    J = cp.Variable((4, 4), PSD=True)
+    pi = cp.hstack([J[3, 3], J[0, 3], J[1, 3], J[2, 3],
+                    J[1, 1] + J[2, 2], -J[0, 1], J[0, 0] + J[2, 2],
+                    -J[0, 2], -J[1, 2], J[0, 0] + J[1, 1]])
+    obj = cp.sum_squares(Rw @ pi - zw) + cp.sum_squares(
+        cp.multiply(prior, pi))
+    prob = cp.Problem(cp.Minimize(obj))
+    try:
+        prob.solve(solver=cp.CLARABEL)
+    except cp.error.SolverError:
+        return None
+    if prob.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+        return None
+    return np.asarray(pi.value, dtype=np.float64)
+
+
+def _clip_psd(pi):
+    lam, V = np.linalg.eigh(pseudo_inertia(pi))
+    if lam.min() >= 0:
+        return pi
+    return _pi_from_pseudo((V * np.maximum(lam, 0.0)) @ V.T)
+
+
+def estimate_payload(model, path, topic='/joint_states', cutoff=None):
+    """Return a :class:`PayloadEstimate` from the bag at ``path``."""
+    n = model.n
+    drives = model_drives(model)
+    T = tip_to_link(model.tool)
+    red = Reduced(n, N_INERTIAL)
+    before = Reduced(n, 0)
+    samples = 0
+    t_first = None
+    duration = 0.0
+    from ..core import inverse_dynamics_batch
+    for piece in prepared_windows(path, model.joint_names, topic, cutoff):
+        step = _decimation(piece.rate, piece.cutoff)
+        idx = np.arange(0, len(piece), step)
+        if t_first is None:
+            t_first = piece.t[0]
+        duration = piece.t[-1] - t_first
+        samples += len(piece)
+        for a in range(0, len(idx), STATE_CHUNK):
+            sel = idx[a:a + STATE_CHUNK]
+            q, qd, qdd = piece.q[sel], piece.qd[sel], piece.qdd[sel]
+            tau = inverse_dynamics_batch(model, q, qd, qdd)
+            if drives is not None:
+                tau = tau + drives.torques(qd, qdd)
+            rest = piece.effort[sel] - tau
+            Y = regressor_batch(model, q, qd, qdd)[
+                :, :, N_INERTIAL * (n - 1):]
+            red.add(Y @ T, rest)
+            before.add(np.zeros((len(sel), n, 0)), rest)
+    if samples == 0:
+        raise IdentificationError(
+            f'{path}: too short: nothing is left after filtering')
+    rows = np.maximum(red.rows, 1)
+    A = red.stacked(np.ones(n))
+    theta, *_ = np.linalg.lstsq(A[:, :-1], A[:, -1], rcond=1e-12)
+    sigma = np.sqrt(red.sq_residuals(theta) / rows)
+    ref = np.sqrt(red.sq_effort() / rows)
+    sigma = np.maximum(sigma, np.maximum(1e-3 * ref, 1e-6))
+    w = 1.0 / sigma
+    Aw = red.stacked(w)
+    Rf = np.linalg.qr(Aw, mode='r')
+    k = min(Rf.shape[0], N_INERTIAL)
+    Rw = np.zeros((N_INERTIAL, N_INERTIAL))
+    zw = np.zeros(N_INERTIAL)
+    Rw[:k], zw[:k] = Rf[:k, :N_INERTIAL], Rf[:k, N_INERTIAL]
+    # scale: a pull of PRIOR_WEIGHT of each column's weight in the data
+    D = np.linalg.norm(Rw, axis=0)
+    D = np.maximum(D, 1e-6 * max(float(D.max()), 1e-12))
+    pi = _solve_sdp(Rw, zw, np.sqrt(PRIOR_WEIGHT) * D)
+    if pi is None:
+        raise IdentificationError(f'{path}: the payload fit failed (the '
+                                  f'solver found no solution)')
+    pi = _clip_psd(pi)
+    pi[0] = max(pi[0], 0.0)
+    m, c, Ic = link_inertials(pi)
+    if m <= 0:
+        c = np.zeros(3)
+        Ic = np.zeros((3, 3))
+    Ic = 0.5 * (Ic + Ic.T)
+    # uncertainty: the residual is mostly model error, not white noise, so
+    # the bound is what a change of the parameters as large as the
+    # residual (RMS over all rows, weighted) could hide, not the white-
+    # noise standard error (smaller by sqrt(rows))
+    total = max(int(red.rows.sum()), 1)
+    res_w = np.sqrt(np.sum(red.sq_residuals(pi) * w ** 2) / total)
+    res_w = np.sqrt(total) * res_w
+    Ds = np.maximum(D, 1e-300)
+    Rs = Rw / Ds
+    U, s, Vt = np.linalg.svd(Rs)
+    keep = s > 1e-12 * s[0]
+    inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 1e30)
+    cov = (Vt.T * inv_s2) @ Vt / np.outer(Ds, Ds) * res_w ** 2
+    est = _uncertainty(m, c, Ic, pi, cov)
+    est.samples = samples
+    est.duration = duration
+    est.residual_before = np.sqrt(before.sq_effort() / rows)
+    est.residual_after = np.sqrt(red.sq_residuals(pi) / rows)
+    est.joint_names = list(model.joint_names)
+    return est
+
+
+def _uncertainty(m, c, Ic, pi, cov):
+    """Propagate the covariance of pi to m, c and I_c (delta method)."""
+    def quantities(p):
+        mm = p[0]
+        cc = p[1:4] / mm if mm > 0 else np.zeros(3)
+        I = np.array([[p[4], p[5], p[7]], [p[5], p[6], p[8]],  # noqa: E741
+                      [p[7], p[8], p[9]]])
+        Icc = I - mm * (cc @ cc * np.eye(3) - np.outer(cc, cc))
+        return np.concatenate([[mm], cc, [Icc[a, b] for a, b in
+                                          INERTIA_KEYS]])
+    base = quantities(pi)
+    G = np.zeros((10, 10))
+    for k in range(10):
+        h = 1e-6 * max(abs(pi[k]), 1e-3)
+        dp = pi.copy()
+        dp[k] += h
+        G[:, k] = (quantities(dp) - base) / h
+    var = np.maximum(np.einsum('ik,kl,il->i', G, cov, G), 0.0)
+    std = np.sqrt(var)
+    mass_std = float(std[0])
+    com_std = std[1:4]
+    in_std = std[4:]
+    # a payload is there when its mass stands out of its uncertainty
+    present = m >= max(MASS_ABS, 2.0 * mass_std)
+    mass_ok = mass_std <= max(MASS_TOL * m, MASS_TOL_ABS)
+    com_ok = [bool(present and com_std[a] <= COM_TOL) for a in range(3)]
+    ref = max([abs(Ic[a, b]) for a, b in INERTIA_KEYS] + [0.0])
+    in_tol = max(INERTIA_TOL * ref, INERTIA_ABS)
+    in_ok = [bool(present and in_std[k] <= in_tol) for k in range(6)]
+    if not present:
+        c = np.zeros(3)
+        Ic = np.zeros((3, 3))
+    return PayloadEstimate(
+        mass=float(m), com=c, inertia=Ic, pi=pi, mass_std=mass_std,
+        com_std=com_std, inertia_std=in_std,
+        determined={'mass': bool(mass_ok), 'present': bool(present),
+                    'com': com_ok, 'inertia': in_ok})
