@@ -63,8 +63,10 @@ from numba import njit
 import numpy as np
 
 from .errors import DynamicsInputError
-from .kernels import (C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, L_P, L_R,
-                      L_TYPE)
+from .kernels import C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, W_WIDTH
+from .kernels.kinematics import joint_trig, link_geometry, revolute
+from .kernels.spatial import (cross, force_to_parent, load3, load9, matmul,
+                              motion_to_child, rot, rot_t)
 
 N_INERTIAL = 10            # parameters per link
 N_DRIVE = 4                # drive parameters per joint
@@ -78,41 +80,29 @@ COULOMB_WIDTH = 0.02       # rad/s (m/s for a prismatic joint)
 # kernel
 
 @njit(cache=True, inline='always')
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0])
+def _accel_to_child(R, p, w, al, ae):
+    """
+    (al, ae) of frame j-1 in frame j (R, p: j in j-1), w frame j-1's.
 
-
-@njit(cache=True, inline='always')
-def _rot(R, x):
-    """R x, R row-major 9-tuple."""
-    return (R[0] * x[0] + R[1] * x[1] + R[2] * x[2],
-            R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-            R[6] * x[0] + R[7] * x[1] + R[8] * x[2])
-
-
-@njit(cache=True, inline='always')
-def _rotT(R, x):
-    """R^T x."""
-    return (R[0] * x[0] + R[3] * x[1] + R[6] * x[2],
-            R[1] * x[0] + R[4] * x[1] + R[7] * x[2],
-            R[2] * x[0] + R[5] * x[1] + R[8] * x[2])
-
-
-@njit(cache=True, inline='always')
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+    ae is the classical acceleration of the origin, so the moved origin
+    adds w x (w x p) to the one motion carry's al x p.
+    """
+    t = cross(w[0], w[1], w[2], p[0], p[1], p[2])
+    t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
+    x = motion_to_child(R, p, (al[0], al[1], al[2],
+                               ae[0] + t[0], ae[1] + t[1], ae[2] + t[2]))
+    return (x[0], x[1], x[2]), (x[3], x[4], x[5])
 
 
 @njit(cache=True)
-def _regressor(links, frames, q, qd, qdd, line, acc, Y):
+def _regressor(links, frames, q, qd, qdd, ws, line, acc, Y):
     """
     Fill Y (n, >= 10n) with the inertial regressor at one state.
 
-    Scratch: ``line`` (n, 6) for each joint's axis as a line in frame 0,
-    ``acc`` (10n, 6) for each column's wrench in frame 0 (force, then
-    moment about the origin of frame 0).  Y's first 10n columns are
-    overwritten.
+    Scratch: ``ws`` (n, W_WIDTH) for the joints' trigonometry, ``line``
+    (n, 6) for each joint's axis as a line in frame 0, ``acc`` (10n, 6)
+    for each column's wrench in frame 0 (force, then moment about the
+    origin of frame 0).  Y's first 10n columns are overwritten.
     """
     n = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
@@ -126,40 +116,24 @@ def _regressor(links, frames, q, qd, qdd, line, acc, Y):
     o0 = (zero, zero, zero)
     # forward pass, base to tip: kinematics in kernel frame j, the link's
     # 6 x 10 block in link axes, then its columns in frame 0
+    joint_trig(links, frames, q, ws)
     for j in range(n):
-        if links[j, L_TYPE] == zero:
-            c = math.cos(q[j])
-            s = math.sin(q[j])
-            d = zero
-        else:
-            c = one
-            s = zero
-            d = q[j]
-        k = L_R
-        r0, r1, r2 = links[j, k], links[j, k + 1], links[j, k + 2]
-        r3, r4, r5 = links[j, k + 3], links[j, k + 4], links[j, k + 5]
-        r6, r7, r8 = links[j, k + 6], links[j, k + 7], links[j, k + 8]
-        R = (r0 * c + r1 * s, r1 * c - r0 * s, r2,
-             r3 * c + r4 * s, r4 * c - r3 * s, r5,
-             r6 * c + r7 * s, r7 * c - r6 * s, r8)
-        p = (links[j, L_P] + r2 * d, links[j, L_P + 1] + r5 * d,
-             links[j, L_P + 2] + r8 * d)
-        o0 = _add(o0, _rot(R0, p))
-        R0 = _matmul(R0, R)
+        R, p = link_geometry(links, frames, j, ws)
+        t = rot(R0, p[0], p[1], p[2])
+        o0 = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
+        R0 = matmul(R0, R)
         z = (R0[2], R0[5], R0[8])
-        oz = _cross(o0, z)
+        oz = cross(o0[0], o0[1], o0[2], z[0], z[1], z[2])
         line[j, 0] = z[0]
         line[j, 1] = z[1]
         line[j, 2] = z[2]
         line[j, 3] = oz[0]
         line[j, 4] = oz[1]
         line[j, 5] = oz[2]
-        # origin acceleration in frame j-1, then everything into frame j
-        ae = _add(_add(ae, _cross(al, p)), _cross(w, _cross(w, p)))
-        ae = _rotT(R, ae)
-        al = _rotT(R, al)
-        w = _rotT(R, w)
-        if links[j, L_TYPE] == zero:
+        # (al, origin acceleration) carried into frame j, then the joint
+        al, ae = _accel_to_child(R, p, w, al, ae)
+        w = rot_t(R, w[0], w[1], w[2])
+        if revolute(links, frames, j):
             al = (al[0] + w[1] * qd[j], al[1] - w[0] * qd[j],
                   al[2] + qdd[j])
             w = (w[0], w[1], w[2] + qd[j])
@@ -167,17 +141,13 @@ def _regressor(links, frames, q, qd, qdd, line, acc, Y):
             ae = (ae[0] + two * w[1] * qd[j], ae[1] - two * w[0] * qd[j],
                   ae[2] + qdd[j])
         # the link frame B in kernel frame j: kinematics in link axes
-        k = L_BODY
-        RB = (links[j, k], links[j, k + 1], links[j, k + 2],
-              links[j, k + 3], links[j, k + 4], links[j, k + 5],
-              links[j, k + 6], links[j, k + 7], links[j, k + 8])
-        pB = (links[j, k + 9], links[j, k + 10], links[j, k + 11])
-        aB = _add(_add(ae, _cross(al, pB)), _cross(w, _cross(w, pB)))
-        wl = _rotT(RB, w)
-        ll = _rotT(RB, al)
-        a = _rotT(RB, aB)
-        RL = _matmul(R0, RB)
-        oL = _add(o0, _rot(R0, pB))
+        RB = load9(links, j, L_BODY)
+        pB = load3(links, j, L_BODY + 9)
+        ll, a = _accel_to_child(RB, pB, w, al, ae)
+        wl = rot_t(RB, w[0], w[1], w[2])
+        RL = matmul(R0, RB)
+        t = rot(R0, pB[0], pB[1], pB[2])
+        oL = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
         col = 10 * j
         # m: force a, no moment about the link origin
         _put(acc, col, RL, oL, a, (zero, zero, zero))
@@ -217,7 +187,7 @@ def _regressor(links, frames, q, qd, qdd, line, acc, Y):
         for col in range(10 * j):
             Y[j, col] = zero
         z0, z1, z2 = line[j, 0], line[j, 1], line[j, 2]
-        if links[j, L_TYPE] == zero:
+        if revolute(links, frames, j):
             m0, m1, m2 = line[j, 3], line[j, 4], line[j, 5]
             for col in range(10 * j, 10 * n):
                 Y[j, col] = (z0 * acc[col, 3] + z1 * acc[col, 4]
@@ -230,23 +200,9 @@ def _regressor(links, frames, q, qd, qdd, line, acc, Y):
 
 
 @njit(cache=True, inline='always')
-def _matmul(A, B):
-    return (A[0] * B[0] + A[1] * B[3] + A[2] * B[6],
-            A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
-            A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
-            A[3] * B[0] + A[4] * B[3] + A[5] * B[6],
-            A[3] * B[1] + A[4] * B[4] + A[5] * B[7],
-            A[3] * B[2] + A[4] * B[5] + A[5] * B[8],
-            A[6] * B[0] + A[7] * B[3] + A[8] * B[6],
-            A[6] * B[1] + A[7] * B[4] + A[8] * B[7],
-            A[6] * B[2] + A[7] * B[5] + A[8] * B[8])
-
-
-@njit(cache=True, inline='always')
 def _put(acc, col, RL, oL, f, mo):
     """Store a link-axes wrench (moment about the link origin) in frame 0."""
-    f0 = _rot(RL, f)
-    m0 = _add(_rot(RL, mo), _cross(oL, f0))
+    f0, m0 = force_to_parent(RL, oL, f, mo)
     acc[col, 0] = f0[0]
     acc[col, 1] = f0[1]
     acc[col, 2] = f0[2]
@@ -257,7 +213,7 @@ def _put(acc, col, RL, oL, f, mo):
 
 @njit(cache=True, inline='always')
 def _imom(Ia, Iw, w):
-    t = _cross(w, Iw)
+    t = cross(w[0], w[1], w[2], Iw[0], Iw[1], Iw[2])
     return (Ia[0] + t[0], Ia[1] + t[1], Ia[2] + t[2])
 
 
@@ -278,10 +234,12 @@ def _drives(qd, qdd, eps, Y, row0):
 @njit(cache=True)
 def _regressor_batch(links, frames, Q, QD, QDD, drives, eps, Y):
     n = links.shape[0]
+    ws = np.empty((max(n, 1), W_WIDTH), links.dtype)
     line = np.empty((max(n, 1), 6))
     acc = np.empty((max(10 * n, 1), 6))
     for i in range(Q.shape[0]):
-        _regressor(links, frames, Q[i], QD[i], QDD[i], line, acc, Y[i])
+        _regressor(links, frames, Q[i], QD[i], QDD[i], ws, line, acc,
+                   Y[i])
         if drives:
             _drives(QD[i], QDD[i], eps, Y[i], 0)
 
