@@ -33,6 +33,14 @@ from .spatial import (cross, force_to_parent, load3, load9, matmul,
 
 
 @njit(cache=True, inline='always')
+def _store(a, row, x, y):
+    """a[row, 0:3] = x, a[row, 3:6] = y (two 3-tuples)."""
+    for k in range(3):
+        a[row, k] = x[k]
+        a[row, 3 + k] = y[k]
+
+
+@njit(cache=True, inline='always')
 def _accel_to_child(R, p, w, al, ae):
     """
     (al, ae) of frame j-1 in frame j (R, p: j in j-1), w frame j-1's.
@@ -77,12 +85,7 @@ def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
         R0 = matmul(R0, R)
         z = (R0[2], R0[5], R0[8])
         oz = cross(o0[0], o0[1], o0[2], z[0], z[1], z[2])
-        line[j, 0] = z[0]
-        line[j, 1] = z[1]
-        line[j, 2] = z[2]
-        line[j, 3] = oz[0]
-        line[j, 4] = oz[1]
-        line[j, 5] = oz[2]
+        _store(line, j, z, oz)
         # (al, origin acceleration) carried into frame j, then the joint
         al, ae = _accel_to_child(R, p, w, al, ae)
         w = rot_t(R, w[0], w[1], w[2])
@@ -156,12 +159,7 @@ def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
 def _put(acc, col, RL, oL, f, mo):
     """Store a link-axes wrench (moment about the link origin) in frame 0."""
     f0, m0 = force_to_parent(RL, oL, f, mo)
-    acc[col, 0] = f0[0]
-    acc[col, 1] = f0[1]
-    acc[col, 2] = f0[2]
-    acc[col, 3] = m0[0]
-    acc[col, 4] = m0[1]
-    acc[col, 5] = m0[2]
+    _store(acc, col, f0, m0)
 
 
 @njit(cache=True, inline='always')
