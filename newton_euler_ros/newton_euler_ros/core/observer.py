@@ -70,6 +70,7 @@ import numpy as np
 
 from .dynamics import coriolis_matrix, gravity_torques, jacobian, mass_matrix
 from .errors import DynamicsInputError
+from .kernels import cholesky_solve
 from .workspace import Workspace
 
 #: what :func:`observer_step` did with a sample
@@ -126,34 +127,6 @@ def _update(D, C, g, qd, tau, lost, armature, gain, dt, restart, p, beta,
 
 
 @njit(cache=True)
-def _cholesky_solve(A, x):
-    """Solve A y = x in place (A symmetric, lower triangle used)."""
-    m = x.shape[0]
-    for a in range(m):
-        for b in range(a + 1):
-            s = A[a, b]
-            for c in range(b):
-                s -= A[a, c] * A[b, c]
-            if a == b:
-                if not s > 0.0:
-                    return False
-                A[a, a] = math.sqrt(s)
-            else:
-                A[a, b] = s / A[b, b]
-    for a in range(m):
-        s = x[a]
-        for c in range(a):
-            s -= A[a, c] * x[c]
-        x[a] = s / A[a, a]
-    for a in range(m - 1, -1, -1):
-        s = x[a]
-        for c in range(a + 1, m):
-            s -= A[c, a] * x[c]
-        x[a] = s / A[a, a]
-    return True
-
-
-@njit(cache=True)
 def _dls_wrench(J, r, damping, A, y, F):
     """
     F = (J J^T + damping^2 I)^-1 J r, the damped (J^T)^+ r.
@@ -176,7 +149,7 @@ def _dls_wrench(J, r, damping, A, y, F):
                     s += J[a, j] * J[b, j]
                 A[a, b] = s
             A[a, a] += lam2
-        if not _cholesky_solve(A, y):
+        if cholesky_solve(A, y, A, y) != -1:     # in place
             return False
         for a in range(6):
             F[a] = y[a]
@@ -189,7 +162,7 @@ def _dls_wrench(J, r, damping, A, y, F):
                     s += J[c, a] * J[c, b]
                 A[a, b] = s
             A[a, a] += lam2
-        if not _cholesky_solve(A, y):
+        if cholesky_solve(A, y, A, y) != -1:     # in place
             return False
         for c in range(6):
             s = 0.0

@@ -54,17 +54,16 @@ within 1e-4 of +-1 from |qd| = 5 eps.  ``eps`` is the Coulomb width,
 
 The kernels work in kernel frames (joint axis on z); ``links[j, L_BODY:]``
 gives the link frame in kernel frame j (see ``model.compile_arrays``).
-This module keeps its kernel to itself and takes only the column and row
-constants from ``kernels``.
+The compiled pass is ``kernels/regressor.py`` (``regressor_columns``,
+``drive_columns``), called through ``kernels.run_regressor_batch``; this
+module checks the inputs and owns the parameter helpers.
 """
 import math
 
-from numba import njit
 import numpy as np
 
+from . import kernels as K
 from .errors import DynamicsInputError
-from .kernels import (C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, L_P, L_R,
-                      L_TYPE)
 
 N_INERTIAL = 10            # parameters per link
 N_DRIVE = 4                # drive parameters per joint
@@ -72,218 +71,6 @@ DRIVE_NAMES = ('viscous', 'coulomb', 'offset', 'armature')
 INERTIAL_NAMES = ('m', 'mcx', 'mcy', 'mcz', 'Ixx', 'Ixy', 'Iyy', 'Ixz',
                   'Iyz', 'Izz')
 COULOMB_WIDTH = 0.02       # rad/s (m/s for a prismatic joint)
-
-
-# ---------------------------------------------------------------------------
-# kernel
-
-@njit(cache=True, inline='always')
-def _cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0])
-
-
-@njit(cache=True, inline='always')
-def _rot(R, x):
-    """R x, R row-major 9-tuple."""
-    return (R[0] * x[0] + R[1] * x[1] + R[2] * x[2],
-            R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
-            R[6] * x[0] + R[7] * x[1] + R[8] * x[2])
-
-
-@njit(cache=True, inline='always')
-def _rotT(R, x):
-    """R^T x."""
-    return (R[0] * x[0] + R[3] * x[1] + R[6] * x[2],
-            R[1] * x[0] + R[4] * x[1] + R[7] * x[2],
-            R[2] * x[0] + R[5] * x[1] + R[8] * x[2])
-
-
-@njit(cache=True, inline='always')
-def _add(a, b):
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
-
-
-@njit(cache=True)
-def _regressor(links, frames, q, qd, qdd, line, acc, Y):
-    """
-    Fill Y (n, >= 10n) with the inertial regressor at one state.
-
-    Scratch: ``line`` (n, 6) for each joint's axis as a line in frame 0,
-    ``acc`` (10n, 6) for each column's wrench in frame 0 (force, then
-    moment about the origin of frame 0).  Y's first 10n columns are
-    overwritten.
-    """
-    n = links.shape[0]
-    zero = frames[F_CONST, C_ZERO]
-    one = frames[F_CONST, C_ONE]
-    two = one + one
-    ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
-    w = (zero, zero, zero)
-    al = (zero, zero, zero)
-    # pose of kernel frame j in frame 0
-    R0 = (one, zero, zero, zero, one, zero, zero, zero, one)
-    o0 = (zero, zero, zero)
-    # forward pass, base to tip: kinematics in kernel frame j, the link's
-    # 6 x 10 block in link axes, then its columns in frame 0
-    for j in range(n):
-        if links[j, L_TYPE] == zero:
-            c = math.cos(q[j])
-            s = math.sin(q[j])
-            d = zero
-        else:
-            c = one
-            s = zero
-            d = q[j]
-        k = L_R
-        r0, r1, r2 = links[j, k], links[j, k + 1], links[j, k + 2]
-        r3, r4, r5 = links[j, k + 3], links[j, k + 4], links[j, k + 5]
-        r6, r7, r8 = links[j, k + 6], links[j, k + 7], links[j, k + 8]
-        R = (r0 * c + r1 * s, r1 * c - r0 * s, r2,
-             r3 * c + r4 * s, r4 * c - r3 * s, r5,
-             r6 * c + r7 * s, r7 * c - r6 * s, r8)
-        p = (links[j, L_P] + r2 * d, links[j, L_P + 1] + r5 * d,
-             links[j, L_P + 2] + r8 * d)
-        o0 = _add(o0, _rot(R0, p))
-        R0 = _matmul(R0, R)
-        z = (R0[2], R0[5], R0[8])
-        oz = _cross(o0, z)
-        line[j, 0] = z[0]
-        line[j, 1] = z[1]
-        line[j, 2] = z[2]
-        line[j, 3] = oz[0]
-        line[j, 4] = oz[1]
-        line[j, 5] = oz[2]
-        # origin acceleration in frame j-1, then everything into frame j
-        ae = _add(_add(ae, _cross(al, p)), _cross(w, _cross(w, p)))
-        ae = _rotT(R, ae)
-        al = _rotT(R, al)
-        w = _rotT(R, w)
-        if links[j, L_TYPE] == zero:
-            al = (al[0] + w[1] * qd[j], al[1] - w[0] * qd[j],
-                  al[2] + qdd[j])
-            w = (w[0], w[1], w[2] + qd[j])
-        else:
-            ae = (ae[0] + two * w[1] * qd[j], ae[1] - two * w[0] * qd[j],
-                  ae[2] + qdd[j])
-        # the link frame B in kernel frame j: kinematics in link axes
-        k = L_BODY
-        RB = (links[j, k], links[j, k + 1], links[j, k + 2],
-              links[j, k + 3], links[j, k + 4], links[j, k + 5],
-              links[j, k + 6], links[j, k + 7], links[j, k + 8])
-        pB = (links[j, k + 9], links[j, k + 10], links[j, k + 11])
-        aB = _add(_add(ae, _cross(al, pB)), _cross(w, _cross(w, pB)))
-        wl = _rotT(RB, w)
-        ll = _rotT(RB, al)
-        a = _rotT(RB, aB)
-        RL = _matmul(R0, RB)
-        oL = _add(o0, _rot(R0, pB))
-        col = 10 * j
-        # m: force a, no moment about the link origin
-        _put(acc, col, RL, oL, a, (zero, zero, zero))
-        # m c_i: force al x e_i + w x (w x e_i), moment e_i x a
-        _put(acc, col + 1, RL, oL,
-             (zero - wl[1] * wl[1] - wl[2] * wl[2],
-              ll[2] + wl[0] * wl[1], wl[0] * wl[2] - ll[1]),
-             (zero, zero - a[2], a[1]))
-        _put(acc, col + 2, RL, oL,
-             (wl[0] * wl[1] - ll[2],
-              zero - wl[0] * wl[0] - wl[2] * wl[2],
-              ll[0] + wl[1] * wl[2]),
-             (a[2], zero, zero - a[0]))
-        _put(acc, col + 3, RL, oL,
-             (ll[1] + wl[0] * wl[2], wl[1] * wl[2] - ll[0],
-              zero - wl[0] * wl[0] - wl[1] * wl[1]),
-             (zero - a[1], a[0], zero))
-        # inertia entries: moment I al + w x (I w), no force
-        a0, a1, a2 = ll
-        w0, w1, w2 = wl
-        zz = (zero, zero, zero)
-        _put(acc, col + 4, RL, oL, zz,
-             _imom((a0, zero, zero), (w0, zero, zero), wl))      # Ixx
-        _put(acc, col + 5, RL, oL, zz,
-             _imom((a1, a0, zero), (w1, w0, zero), wl))          # Ixy
-        _put(acc, col + 6, RL, oL, zz,
-             _imom((zero, a1, zero), (zero, w1, zero), wl))      # Iyy
-        _put(acc, col + 7, RL, oL, zz,
-             _imom((a2, zero, a0), (w2, zero, w0), wl))          # Ixz
-        _put(acc, col + 8, RL, oL, zz,
-             _imom((zero, a2, a1), (zero, w2, w1), wl))          # Iyz
-        _put(acc, col + 9, RL, oL, zz,
-             _imom((zero, zero, a2), (zero, zero, w2), wl))      # Izz
-    # each joint takes the moment about (revolute) or the force along
-    # (prismatic) its axis of the wrenches of the links it carries
-    for j in range(n):
-        for col in range(10 * j):
-            Y[j, col] = zero
-        z0, z1, z2 = line[j, 0], line[j, 1], line[j, 2]
-        if links[j, L_TYPE] == zero:
-            m0, m1, m2 = line[j, 3], line[j, 4], line[j, 5]
-            for col in range(10 * j, 10 * n):
-                Y[j, col] = (z0 * acc[col, 3] + z1 * acc[col, 4]
-                             + z2 * acc[col, 5] + m0 * acc[col, 0]
-                             + m1 * acc[col, 1] + m2 * acc[col, 2])
-        else:
-            for col in range(10 * j, 10 * n):
-                Y[j, col] = (z0 * acc[col, 0] + z1 * acc[col, 1]
-                             + z2 * acc[col, 2])
-
-
-@njit(cache=True, inline='always')
-def _matmul(A, B):
-    return (A[0] * B[0] + A[1] * B[3] + A[2] * B[6],
-            A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
-            A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
-            A[3] * B[0] + A[4] * B[3] + A[5] * B[6],
-            A[3] * B[1] + A[4] * B[4] + A[5] * B[7],
-            A[3] * B[2] + A[4] * B[5] + A[5] * B[8],
-            A[6] * B[0] + A[7] * B[3] + A[8] * B[6],
-            A[6] * B[1] + A[7] * B[4] + A[8] * B[7],
-            A[6] * B[2] + A[7] * B[5] + A[8] * B[8])
-
-
-@njit(cache=True, inline='always')
-def _put(acc, col, RL, oL, f, mo):
-    """Store a link-axes wrench (moment about the link origin) in frame 0."""
-    f0 = _rot(RL, f)
-    m0 = _add(_rot(RL, mo), _cross(oL, f0))
-    acc[col, 0] = f0[0]
-    acc[col, 1] = f0[1]
-    acc[col, 2] = f0[2]
-    acc[col, 3] = m0[0]
-    acc[col, 4] = m0[1]
-    acc[col, 5] = m0[2]
-
-
-@njit(cache=True, inline='always')
-def _imom(Ia, Iw, w):
-    t = _cross(w, Iw)
-    return (Ia[0] + t[0], Ia[1] + t[1], Ia[2] + t[2])
-
-
-@njit(cache=True)
-def _drives(qd, qdd, eps, Y, row0):
-    """Drive columns after the 10n inertial ones (rows ``row0``.. of Y)."""
-    n = qd.shape[0]
-    base = 10 * n
-    for j in range(n):
-        for k in range(4 * n):
-            Y[j, base + k] = 0.0
-        Y[j, base + 4 * j] = qd[j]
-        Y[j, base + 4 * j + 1] = math.tanh(qd[j] / eps)
-        Y[j, base + 4 * j + 2] = 1.0
-        Y[j, base + 4 * j + 3] = qdd[j]
-
-
-@njit(cache=True)
-def _regressor_batch(links, frames, Q, QD, QDD, drives, eps, Y):
-    n = links.shape[0]
-    line = np.empty((max(n, 1), 6))
-    acc = np.empty((max(10 * n, 1), 6))
-    for i in range(Q.shape[0]):
-        _regressor(links, frames, Q[i], QD[i], QDD[i], line, acc, Y[i])
-        if drives:
-            _drives(QD[i], QDD[i], eps, Y[i], 0)
 
 
 # ---------------------------------------------------------------------------
@@ -343,8 +130,15 @@ def regressor_batch(model, Q, QD, QDD, *, drives=False,
           or out.dtype != np.float64 or not out.flags.c_contiguous):
         raise DynamicsInputError(
             f'out must be a C-contiguous float64 array of shape {shape}')
-    _regressor_batch(model.links_array, model.frames_array, Q, QD, QDD,
-                     bool(drives), eps, out)
+    n = max(model.n, 1)
+    ws = np.empty((n, K.W_WIDTH))
+    line = np.empty((n, 6))
+    acc = np.empty((10 * n, 6))
+    code = K.run_regressor_batch(model.packed, Q, QD, QDD, bool(drives), eps,
+                                 ws, line, acc, out)
+    if code != -1:      # sizes are checked above: cannot happen
+        raise DynamicsInputError(f'regressor kernel refused its input '
+                                 f'(status {code})')
     return out
 
 

@@ -269,6 +269,10 @@ def _run_every_kernel(mod, model, dtype):
     assert mod.run_mass_matrix_batch(P, Q, ws, MM, status) == -1
     assert mod.run_gravity_torques_batch(P, Q, ws, TAU, status) == -1
     assert mod.run_coriolis_matrix_batch(P, Q, Q, ws, cw, MM, status) == -1
+    YY = np.zeros((3, n, 14 * n), f)
+    assert mod.run_regressor_batch(P, Q, Q, Q, True, f(0.02), ws,
+                                   np.zeros((n, 6), f),
+                                   np.zeros((10 * n, 6), f), YY) == -1
     assert mod.mass_matrix_columns(links, frames, q, ws, scratch, M) == -1
     D = M.copy()
     assert mod.mass_matrix_crba(links, frames, q, ws, M) == -1

@@ -32,6 +32,8 @@ file                   what it holds
 ``spatial.py``         3-vector and 6x6 helpers; the one force carry
                        (``force_to_parent``) and the one motion carry
                        (``motion_to_child``)
+``regressor.py``       the joint-torque regressor Y (tau = Y pi) and its
+                       drive columns
 ``cholesky.py``        Cholesky solve
 ``status.py``          finiteness checks and status codes in the kernels
 ``layout.py``          every array column by name (``L_*``, ``F_*``,
@@ -69,7 +71,8 @@ from .entry import (run_coriolis_matrix, run_coriolis_matrix_batch,
                     run_gravity_torques, run_gravity_torques_batch,
                     run_inverse_dynamics, run_inverse_dynamics_batch,
                     run_jacobian, run_link_poses, run_mass_matrix,
-                    run_mass_matrix_batch, run_mass_matrix_crba)
+                    run_mass_matrix_batch, run_mass_matrix_crba,
+                    run_regressor_batch)
 from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
@@ -100,14 +103,15 @@ __all__ = [
     'run_gravity_torques', 'run_gravity_torques_batch',
     'run_inverse_dynamics', 'run_inverse_dynamics_batch', 'run_jacobian',
     'run_link_poses', 'run_mass_matrix', 'run_mass_matrix_batch',
-    'run_mass_matrix_crba', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
+    'run_mass_matrix_crba', 'run_regressor_batch', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
     'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
     'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',
 ]
 
 # the kernel files in the order they import each other
 MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
-           'newton_euler', 'crba', 'coriolis', 'aba', 'entry')
+           'newton_euler', 'crba', 'coriolis', 'aba', 'regressor',
+           'entry')
 _DIR = os.path.dirname(os.path.abspath(__file__))
 
 

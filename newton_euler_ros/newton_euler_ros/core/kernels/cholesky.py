@@ -24,7 +24,10 @@ def cholesky_solve(A, b, L, x):
     Solve A x = b for symmetric positive definite A by Cholesky.
 
     Returns -1 on success, or the index of the first pivot that is not
-    positive (A is not positive definite there).  A is left unchanged.
+    positive (A is not positive definite there).  A is left unchanged
+    unless L is A: ``cholesky_solve(A, b, A, b)`` factorises and solves
+    in place (each entry of A is read before its L entry overwrites it,
+    and b[i] before x[i]); the observer's damped solve uses that.
     """
     n = A.shape[0]
     for i in range(n):

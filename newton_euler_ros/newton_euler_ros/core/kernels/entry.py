@@ -40,6 +40,7 @@ from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, OVERFLOW, SINGULAR,
                      SIZE, VELOCITY, W_WIDTH, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
                            mass_matrix_columns, recursion)
+from .regressor import drive_columns, regressor_columns
 from .status import check_finite, first_bad_row, first_nonfinite, matrix_status
 
 
@@ -285,3 +286,33 @@ def run_link_poses(P, q, ws, Ts):
         return SIZE + 5
     forward_kinematics(links, frames, q, ws, Ts)
     return matrix_status(Ts)
+
+
+@njit(**ENTRY)
+def run_regressor_batch(P, Q, QD, QDD, drives, eps, ws, line, acc, Y):
+    """
+    Fill the torque regressor Y at each row (``regressor_columns``).
+
+    The caller checks the states (numpy, once per batch); this checks the
+    scratch and ``Y`` sizes only: -1, or ``SIZE + 5`` (scratch) or
+    ``SIZE + 4`` (Y).  With ``drives`` the 4n drive columns follow.
+    """
+    links, frames = _split(P)
+    n = links.shape[0]
+    m = Q.shape[0]
+    if (QD.shape[0] != m or QDD.shape[0] != m or Q.shape[1] != n
+            or QD.shape[1] != n or QDD.shape[1] != n):
+        return SIZE
+    if (ws.shape[0] < n or ws.shape[1] != W_WIDTH or line.shape[0] < n
+            or line.shape[1] != 6 or acc.shape[0] < 10 * n
+            or acc.shape[1] != 6):
+        return SIZE + 5
+    if (Y.shape[0] != m or Y.shape[1] != n
+            or Y.shape[2] != (14 * n if drives else 10 * n)):
+        return SIZE + 4
+    for i in range(m):
+        regressor_columns(links, frames, Q[i], QD[i], QDD[i], ws, line, acc,
+                          Y[i])
+        if drives:
+            drive_columns(frames, QD[i], QDD[i], eps, Y[i])
+    return -1

@@ -1,0 +1,184 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The joint-torque regressor Y(q, qd, qdd), tau = Y pi, as a compiled pass.
+
+One forward pass, base to tip: each link's kinematics in its own axes
+give its 6 x 10 block (the wrench each inertial parameter causes), which
+the one force carry (``force_to_parent``) takes to frame 0; each joint
+then takes the moment about (revolute) or the force along (prismatic) its
+axis of the links it carries.  The drive columns (viscous, Coulomb,
+offset, armature) follow the 10n inertial ones when asked for.  Python
+calls ``entry.run_regressor_batch``; ``core.regressor`` is the API.
+"""
+import math
+
+from ._jit import njit
+from .kinematics import joint_trig, link_geometry, revolute
+from .layout import C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY
+from .spatial import (cross, force_to_parent, load3, load9, matmul,
+                      motion_to_child, rot, rot_t)
+
+
+@njit(cache=True, inline='always')
+def _store(a, row, x, y):
+    """a[row, 0:3] = x, a[row, 3:6] = y (two 3-tuples)."""
+    for k in range(3):
+        a[row, k] = x[k]
+        a[row, 3 + k] = y[k]
+
+
+@njit(cache=True, inline='always')
+def _accel_to_child(R, p, w, al, ae):
+    """
+    (al, ae) of frame j-1 in frame j (R, p: j in j-1), w frame j-1's.
+
+    ae is the classical acceleration of the origin, so the moved origin
+    adds w x (w x p) to the one motion carry's al x p.
+    """
+    t = cross(w[0], w[1], w[2], p[0], p[1], p[2])
+    t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
+    x = motion_to_child(R, p, (al[0], al[1], al[2],
+                               ae[0] + t[0], ae[1] + t[1], ae[2] + t[2]))
+    return (x[0], x[1], x[2]), (x[3], x[4], x[5])
+
+
+@njit(cache=True)
+def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
+    """
+    Fill Y (n, >= 10n) with the inertial regressor at one state.
+
+    Scratch: ``ws`` (n, W_WIDTH) for the joints' trigonometry, ``line``
+    (n, 6) for each joint's axis as a line in frame 0, ``acc`` (10n, 6)
+    for each column's wrench in frame 0 (force, then moment about the
+    origin of frame 0).  Y's first 10n columns are overwritten.
+    """
+    n = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    one = frames[F_CONST, C_ONE]
+    two = one + one
+    ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    w = (zero, zero, zero)
+    al = (zero, zero, zero)
+    # pose of kernel frame j in frame 0
+    R0 = (one, zero, zero, zero, one, zero, zero, zero, one)
+    o0 = (zero, zero, zero)
+    # forward pass, base to tip: kinematics in kernel frame j, the link's
+    # 6 x 10 block in link axes, then its columns in frame 0
+    joint_trig(links, frames, q, ws)
+    for j in range(n):
+        R, p = link_geometry(links, frames, j, ws)
+        t = rot(R0, p[0], p[1], p[2])
+        o0 = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
+        R0 = matmul(R0, R)
+        z = (R0[2], R0[5], R0[8])
+        oz = cross(o0[0], o0[1], o0[2], z[0], z[1], z[2])
+        _store(line, j, z, oz)
+        # (al, origin acceleration) carried into frame j, then the joint
+        al, ae = _accel_to_child(R, p, w, al, ae)
+        w = rot_t(R, w[0], w[1], w[2])
+        if revolute(links, frames, j):
+            al = (al[0] + w[1] * qd[j], al[1] - w[0] * qd[j],
+                  al[2] + qdd[j])
+            w = (w[0], w[1], w[2] + qd[j])
+        else:
+            ae = (ae[0] + two * w[1] * qd[j], ae[1] - two * w[0] * qd[j],
+                  ae[2] + qdd[j])
+        # the link frame B in kernel frame j: kinematics in link axes
+        RB = load9(links, j, L_BODY)
+        pB = load3(links, j, L_BODY + 9)
+        ll, a = _accel_to_child(RB, pB, w, al, ae)
+        wl = rot_t(RB, w[0], w[1], w[2])
+        RL = matmul(R0, RB)
+        t = rot(R0, pB[0], pB[1], pB[2])
+        oL = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
+        col = 10 * j
+        # m: force a, no moment about the link origin
+        _put(acc, col, RL, oL, a, (zero, zero, zero))
+        # m c_i: force al x e_i + w x (w x e_i), moment e_i x a
+        _put(acc, col + 1, RL, oL,
+             (zero - wl[1] * wl[1] - wl[2] * wl[2],
+              ll[2] + wl[0] * wl[1], wl[0] * wl[2] - ll[1]),
+             (zero, zero - a[2], a[1]))
+        _put(acc, col + 2, RL, oL,
+             (wl[0] * wl[1] - ll[2],
+              zero - wl[0] * wl[0] - wl[2] * wl[2],
+              ll[0] + wl[1] * wl[2]),
+             (a[2], zero, zero - a[0]))
+        _put(acc, col + 3, RL, oL,
+             (ll[1] + wl[0] * wl[2], wl[1] * wl[2] - ll[0],
+              zero - wl[0] * wl[0] - wl[1] * wl[1]),
+             (zero - a[1], a[0], zero))
+        # inertia entries: moment I al + w x (I w), no force
+        a0, a1, a2 = ll
+        w0, w1, w2 = wl
+        zz = (zero, zero, zero)
+        _put(acc, col + 4, RL, oL, zz,
+             _imom((a0, zero, zero), (w0, zero, zero), wl))      # Ixx
+        _put(acc, col + 5, RL, oL, zz,
+             _imom((a1, a0, zero), (w1, w0, zero), wl))          # Ixy
+        _put(acc, col + 6, RL, oL, zz,
+             _imom((zero, a1, zero), (zero, w1, zero), wl))      # Iyy
+        _put(acc, col + 7, RL, oL, zz,
+             _imom((a2, zero, a0), (w2, zero, w0), wl))          # Ixz
+        _put(acc, col + 8, RL, oL, zz,
+             _imom((zero, a2, a1), (zero, w2, w1), wl))          # Iyz
+        _put(acc, col + 9, RL, oL, zz,
+             _imom((zero, zero, a2), (zero, zero, w2), wl))      # Izz
+    # each joint takes the moment about (revolute) or the force along
+    # (prismatic) its axis of the wrenches of the links it carries
+    for j in range(n):
+        for col in range(10 * j):
+            Y[j, col] = zero
+        z0, z1, z2 = line[j, 0], line[j, 1], line[j, 2]
+        if revolute(links, frames, j):
+            m0, m1, m2 = line[j, 3], line[j, 4], line[j, 5]
+            for col in range(10 * j, 10 * n):
+                Y[j, col] = (z0 * acc[col, 3] + z1 * acc[col, 4]
+                             + z2 * acc[col, 5] + m0 * acc[col, 0]
+                             + m1 * acc[col, 1] + m2 * acc[col, 2])
+        else:
+            for col in range(10 * j, 10 * n):
+                Y[j, col] = (z0 * acc[col, 0] + z1 * acc[col, 1]
+                             + z2 * acc[col, 2])
+
+
+@njit(cache=True, inline='always')
+def _put(acc, col, RL, oL, f, mo):
+    """Store a link-axes wrench (moment about the link origin) in frame 0."""
+    f0, m0 = force_to_parent(RL, oL, f, mo)
+    _store(acc, col, f0, m0)
+
+
+@njit(cache=True, inline='always')
+def _imom(Ia, Iw, w):
+    t = cross(w[0], w[1], w[2], Iw[0], Iw[1], Iw[2])
+    return (Ia[0] + t[0], Ia[1] + t[1], Ia[2] + t[2])
+
+
+@njit(cache=True)
+def drive_columns(frames, qd, qdd, eps, Y):
+    """Fill the 4n drive columns after the 10n inertial ones of Y."""
+    n = qd.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    one = frames[F_CONST, C_ONE]
+    base = 10 * n
+    for j in range(n):
+        for k in range(4 * n):
+            Y[j, base + k] = zero
+        Y[j, base + 4 * j] = qd[j]
+        Y[j, base + 4 * j + 1] = math.tanh(qd[j] / eps)
+        Y[j, base + 4 * j + 2] = one
+        Y[j, base + 4 * j + 3] = qdd[j]
