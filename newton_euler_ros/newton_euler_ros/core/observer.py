@@ -71,7 +71,12 @@ import numpy as np
 from .dynamics import coriolis_matrix, gravity_torques, jacobian, mass_matrix
 from .errors import DynamicsInputError
 from .kernels import cholesky_solve
+from .kernels._jit import uses_kernels
 from .workspace import Workspace
+
+# this file's compiled functions call cholesky_solve: a kernel edit must
+# recompile them (numba's cache stamps a function with its own file only)
+uses_kernels(__file__)
 
 #: what :func:`observer_step` did with a sample
 UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \

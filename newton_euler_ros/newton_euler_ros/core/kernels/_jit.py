@@ -27,6 +27,10 @@ its own source file only, and an entry point carries compiled copies of
 the helpers it calls from the other kernel files; so every kernel
 function here is stamped with all the kernel files at once
 (``_PackageStamp``): editing any of them recompiles every entry point.
+A compiled module outside the package that calls kernel functions (the
+momentum observer) registers its file with :func:`uses_kernels` before
+its functions are decorated: its functions are then stamped with its own
+file and all the kernel files.
 """
 import os
 
@@ -48,6 +52,12 @@ except NameError:
 ENTRY = {'cache': True, '_nrt': False}
 
 _DIR = os.path.dirname(os.path.abspath(__file__))
+_USERS = set()      # files outside the package whose functions call kernels
+
+
+def uses_kernels(path):
+    """Stamp the compiled functions of file ``path`` with the kernel files."""
+    _USERS.add(os.path.abspath(path))
 
 
 def package_stamp():
@@ -70,12 +80,14 @@ def _install_package_stamp():
         class Locator(base):
             @classmethod
             def from_function(cls, py_func, py_file):
-                if os.path.dirname(os.path.abspath(py_file)) != _DIR:
+                path = os.path.abspath(py_file)
+                if os.path.dirname(path) != _DIR and path not in _USERS:
                     return None
                 return super().from_function(py_func, py_file)
 
             def get_source_stamp(self):
-                return stamp
+                own = super().get_source_stamp()    # this function's file
+                return (stamp, own)
 
         Locator.__name__ = f'KernelPackage{base.__name__}'
         return Locator
