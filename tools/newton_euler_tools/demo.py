@@ -53,6 +53,22 @@ class DemoError(Exception):
     """The demo could not run to completion."""
 
 
+def stop_children(children, recorder, status):
+    """Stop the children not stopped yet (last started first), close ``recorder``."""
+    for child in reversed(children):
+        if child.label not in status:
+            status[child.label] = child.stop()
+    recorder.close()
+
+
+def check_exits(label, status, log_dir=None):
+    """Raise DemoError when a child did not exit 0 (status: label -> code)."""
+    bad = {k: v for k, v in status.items() if v != 0}
+    if bad:
+        where = f' (logs in {log_dir})' if log_dir else ''
+        raise DemoError(f'[{label}] nodes did not exit cleanly: {bad}{where}')
+
+
 def base_domain(count=2):
     """
     Return the first of ``count`` domain ids, one per run.
@@ -257,14 +273,8 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
         status[controller.label] = controller.stop()
         recorder.drain()
     finally:
-        for child in reversed(children):
-            if child.label not in status:
-                status[child.label] = child.stop()
-        recorder.close()
-    bad = {k: v for k, v in status.items() if v != 0}
-    if bad:
-        raise DemoError(f'[{label}] nodes did not exit cleanly: {bad} '
-                        f'(logs in {log_dir})')
+        stop_children(children, recorder, status)
+    check_exits(label, status, log_dir)
     print(f'[{label}] stopped: all nodes exited 0', flush=True)
     if recorder.t0 is None:
         raise DemoError(f'[{label}] no start time received')

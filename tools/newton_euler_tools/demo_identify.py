@@ -60,7 +60,8 @@ import xml.etree.ElementTree as ET
 from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import base_domain, Child, DemoError, Recorder, wait_for
+from .demo import (base_domain, check_exits, Child, DemoError, Recorder,
+                   stop_children, wait_for)
 from .demo_pick import trajectory_message
 from .ident_example import BASE, panda_path, perturb_urdf, TIP
 
@@ -245,12 +246,8 @@ def run(label, scene_path, node_urdf, segment, duration, domain, log_dir,
             if time.monotonic() > end:
                 raise DemoError(f'[{label}] did not reach t = {duration} s')
     finally:
-        for child in reversed(children):
-            status[child.label] = child.stop()
-        rec.close()
-    bad = {k: v for k, v in status.items() if v != 0}
-    if bad:
-        raise DemoError(f'[{label}] nodes did not exit cleanly: {bad}')
+        stop_children(children, rec, status)
+    check_exits(label, status)
     ns = np.array(rec.stamps_ns, dtype=np.int64)
     t = np.array([s[0] for s in rec.states]) - rec.t0
     keep = (t >= -1e-9) & (t <= duration + 1e-9)

@@ -42,7 +42,8 @@ import warnings
 from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import base_domain, Child, DemoError, Recorder, wait_for
+from .demo import (base_domain, check_exits, Child, DemoError, Recorder,
+                   stop_children, wait_for)
 
 SCENE = 'puma_pick_and_place'
 # 3 kg held at the flange origin, the Puma's wrist centre: a load on the
@@ -191,12 +192,8 @@ def run(label, update_feedforward, duration, domain, log_dir, model, q0):
             if time.monotonic() > end:
                 raise DemoError(f'[{label}] did not reach t = {duration} s')
     finally:
-        for child in reversed(children):
-            status[child.label] = child.stop()
-        rec.close()
-    bad = {k: v for k, v in status.items() if v != 0}
-    if bad:
-        raise DemoError(f'[{label}] nodes did not exit cleanly: {bad}')
+        stop_children(children, rec, status)
+    check_exits(label, status)
     stamps = np.array([s[0] for s in rec.states]) - rec.t0
     keep = (stamps >= -1e-9) & (stamps <= duration + 1e-9)
     order = np.argsort(stamps[keep], kind='stable')

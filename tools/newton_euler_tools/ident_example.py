@@ -155,6 +155,25 @@ def fourier_trajectory(model, rng, period=10.0, harmonics=5, speed=1.2):
     return f
 
 
+def measured_efforts(peer, q, qd, qdd, drives, effort_noise, rng):
+    """
+    Return what the drives of a Pinocchio arm would measure along a path.
+
+    Pinocchio's RNEA (``peer``, a ``peers.PinocchioUrdf``) plus the drive
+    terms (``drives``: viscous, coulomb, coulomb_width, offset, armature)
+    and white effort noise of ``effort_noise`` N m.
+    """
+    import pinocchio as pin
+    tau = np.empty_like(q)
+    for i in range(len(q)):
+        tau[i] = pin.rnea(peer.model, peer.data, peer.config(q[i]), qd[i],
+                          qdd[i])
+    tau += (drives['viscous'] * qd + drives['coulomb'] * np.tanh(
+        qd / drives['coulomb_width']) + drives['offset']
+        + drives['armature'] * qdd)
+    return tau + rng.normal(0, effort_noise, tau.shape)
+
+
 def simulate(truth_urdf_path, model, drives, trajectory, seconds, rate,
              rng, effort_noise=0.05, velocity_noise=2e-3, quantum=2e-6,
              lost=0.02, repeated=0.01, jitter=0.2):
@@ -165,21 +184,13 @@ def simulate(truth_urdf_path, model, drives, trajectory, seconds, rate,
     exactly; ``lost`` of the messages are dropped and ``repeated`` sent
     twice (same values, a later stamp); positions are quantised.
     """
-    import pinocchio as pin
     from .peers import PinocchioUrdf
     peer = PinocchioUrdf(truth_urdf_path, model.joint_names, TIP)
     count = int(seconds * rate)
     t = (np.arange(count) + rng.uniform(-jitter, jitter, count)) / rate
     t[0] = 0.0
     q, qd, qdd = trajectory(t)
-    tau = np.empty_like(q)
-    for i in range(count):
-        tau[i] = pin.rnea(peer.model, peer.data, peer.config(q[i]), qd[i],
-                          qdd[i])
-    tau += (drives['viscous'] * qd + drives['coulomb'] * np.tanh(
-        qd / drives['coulomb_width']) + drives['offset']
-        + drives['armature'] * qdd)
-    tau += rng.normal(0, effort_noise, tau.shape)
+    tau = measured_efforts(peer, q, qd, qdd, drives, effort_noise, rng)
     qm = np.round(q / quantum) * quantum
     qdm = qd + rng.normal(0, velocity_noise, qd.shape)
     keep = rng.random(count) >= lost

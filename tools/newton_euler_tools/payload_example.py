@@ -37,8 +37,8 @@ import warnings
 
 import numpy as np
 
-from .ident_example import (BASE, EXTRA, fourier_trajectory, panda_path,
-                            random_drives, TIP)
+from .ident_example import (BASE, EXTRA, fourier_trajectory,
+                            measured_efforts, panda_path, random_drives, TIP)
 
 MASS = 1.5
 COM = (0.01, -0.02, 0.06)
@@ -92,14 +92,7 @@ def record(path, model, drives, mass, com, inertia_c, seconds=30.0,
         # the payload never tilts
         for X, v in ((q, q[0, 1:]), (qd, 0.0), (qdd, 0.0)):
             X[:, 1:] = v
-    tau = np.empty_like(q)
-    for i in range(count):
-        tau[i] = pin.rnea(peer.model, peer.data, peer.config(q[i]), qd[i],
-                          qdd[i])
-    tau += (drives['viscous'] * qd + drives['coulomb'] * np.tanh(
-        qd / drives['coulomb_width']) + drives['offset']
-        + drives['armature'] * qdd)
-    tau += rng.normal(0, effort_noise, tau.shape)
+    tau = measured_efforts(peer, q, qd, qdd, drives, effort_noise, rng)
     keep = rng.random(count) >= 0.02
     keep[0] = keep[-1] = True
     stamps = np.round((1_000_000_000 + t[keep]) * 1e9).astype(np.int64)
