@@ -272,6 +272,10 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
         # recorder and the simulator give their counts
         status[controller.label] = controller.stop()
         recorder.drain()
+        # the recorder has the last command; give the plant, a process of
+        # its own, the moment it may still need to take it off its queue
+        # (a SIGINT ends its spinning, and it counts only what it took)
+        time.sleep(1.0)
     finally:
         stop_children(children, recorder, status)
     check_exits(label, status, log_dir)
