@@ -5,7 +5,8 @@
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
 #   make demo-identify  excite, record, identify, payload; out/demo_identify/
-#   make bench   run the benchmarks (peers side by side; cost per effect)
+#   make bench   run the benchmarks (peers side by side; cost per effect;
+#                regressor, observer, identification time and memory)
 #   make bench-identify  identification time and memory (1 and 30 min bags)
 #   make peers   add Pinocchio + Robotics Toolbox (reference implementations)
 #   make accuracy  accuracy-vs-time report -> docs/accuracy-vs-time.md (+ peers)
@@ -56,9 +57,10 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_scaling
 	$(PY) -m newton_euler_tools.bench_regressor
 	$(PY) -m newton_euler_tools.bench_observer
+	$(PY) -m newton_euler_tools.bench_identify
 
-# identification: 40 s recording time; 1 and 30 min time and peak memory
-# (about 10 minutes: writing and reading the 30 min bag dominates)
+# identification alone: 40 s recording time; 1 and 30 min time and peak
+# memory (about 10 minutes: writing and reading the 30 min bag dominates)
 bench-identify: setup
 	$(PY) -m newton_euler_tools.bench_identify
 
