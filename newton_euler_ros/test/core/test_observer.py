@@ -51,7 +51,7 @@ def _quiet_load(*args, **kw):
 @pytest.fixture(scope='module')
 def panda():
     """(our model, Pinocchio's reading of the same URDF)."""
-    pytest.importorskip('pinocchio')
+    import pinocchio  # noqa: F401 (a test dependency: make setup installs it)
     from newton_euler_tools.peers import example_robot_urdf, PinocchioUrdf
     try:
         path = example_robot_urdf(PANDA)

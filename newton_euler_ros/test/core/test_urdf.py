@@ -400,7 +400,7 @@ PUBLISHED = [
 
 @pytest.mark.parametrize('relative,tip', PUBLISHED)
 def test_published_urdf_matches_pinocchio(relative, tip):
-    pytest.importorskip('pinocchio')
+    import pinocchio  # noqa: F401 (a test dependency: make setup installs it)
     from newton_euler_tools.peers import example_robot_urdf, PinocchioUrdf
     try:
         path = example_robot_urdf(relative)
