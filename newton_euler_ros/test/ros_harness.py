@@ -30,7 +30,18 @@ PARAMS_DIR = os.path.join(PACKAGE_DIR, 'config', 'params')
 
 
 def domain_id(offset):
-    """Return a domain id unique to this test run and module (1..100)."""
+    """
+    Return a domain id unique to this test run and module (1..100).
+
+    Under pytest-xdist (``make test`` runs two workers) worker k takes
+    ids from its own half, 50 k + 1 .. 50 k + 40, leaving ten above each
+    for the tools that use consecutive ids (demos, latency phases), so
+    two workers never share a domain.
+    """
+    worker = os.environ.get('PYTEST_XDIST_WORKER', '')
+    if worker.startswith('gw') and worker[2:].isdigit():
+        half = int(worker[2:]) % 2
+        return 1 + 50 * half + (os.getpid() * 7 + offset) % 40
     return 1 + (os.getpid() * 7 + offset) % 100
 
 

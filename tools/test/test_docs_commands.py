@@ -43,6 +43,7 @@ import time
 
 from newton_euler_tools.processes import ros_env
 import pytest
+from ros_harness import domain_id
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__))))
@@ -92,7 +93,7 @@ def scratch_root(tmp_path):
 
 
 def _env(page):
-    env = ros_env(1 + (os.getpid() * 7 + 13 + PAGES.index(page)) % 100)
+    env = ros_env(domain_id(13 + PAGES.index(page)))
     env.setdefault('NUMBA_CACHE_DIR', os.path.join(ROOT, 'build',
                                                    'numba-cache'))
     env.pop('MAKEFLAGS', None)
