@@ -253,53 +253,52 @@ def test_a_workspace_of_another_model_is_refused():
 
 WARM_CALLS = """
 import numpy as np
-from numba import njit
 from numba.core.runtime import rtsys
 from newton_euler_ros.core import load_robot, Workspace
 from newton_euler_ros.core import kernels as K
 arm = load_robot('planar_rp')
 n = arm.n
 ws = Workspace(arm)
+P = arm.packed
 q = np.linspace(-1, 1, n)
+w = np.ones(6)
+tau = np.empty(n)
+D = np.empty((n, n))
+J = np.empty((6, n))
 Q = np.tile(q, (3, 1))
-args = (arm.packed, q, np.ones(6), np.empty(n), np.empty((n, n)),
-        np.empty((6, n)), Q, np.zeros((3, 6)), np.empty((3, n)),
-        np.empty((3, n, n)), ws.ws, ws.scratch, ws.cw, ws.aw, ws.frames,
-        ws.status)
-
-
-@njit
-def every_entry_point(reps, P, q, w, tau, D, J, Q, W, out, DD, ws, scratch,
-                      cw, aw, frames, status):
-    for _ in range(reps):
-        K.run_inverse_dynamics(P, q, q, q, w, 3 | (1 << K.WRENCH_SHIFT), ws,
-                               tau)
-        K.run_gravity_torques(P, q, ws, tau)
-        K.run_mass_matrix_crba(P, q, ws, D)
-        K.run_mass_matrix(P, q, False, ws, scratch, D)
-        K.run_coriolis_matrix(P, q, q, True, ws, cw, scratch, D)
-        K.run_coriolis_matrix(P, q, q, False, ws, cw, scratch, D)
-        K.run_forward_dynamics(P, q, q, q, w, 3, ws, aw, tau)
-        K.run_jacobian(P, q, True, ws, frames, J)
-        K.run_link_poses(P, q, ws, frames)
-        K.run_inverse_dynamics_batch(P, Q, Q, Q, W, 3, ws, out, status)
-        K.run_forward_dynamics_batch(P, Q, Q, Q, W, 3, ws, aw, out, status)
-        K.run_mass_matrix_batch(P, Q, ws, DD, status)
-        K.run_gravity_torques_batch(P, Q, ws, out, status)
-        K.run_coriolis_matrix_batch(P, Q, Q, ws, cw, DD, status)
-
-
-def allocations(reps):
-    before = rtsys.get_allocation_stats()
-    every_entry_point(reps, *args)
-    after = rtsys.get_allocation_stats()
-    return after.alloc - before.alloc
-
-
-allocations(1)                        # compile
-# the call from Python wraps each array argument (a fixed count); the
-# kernels themselves must add nothing per repetition
-print(allocations(101) - allocations(1))
+W = np.zeros((3, 6))
+out = np.empty((3, n))
+DD = np.empty((3, n, n))
+calls = [
+    lambda: K.run_inverse_dynamics(P, q, q, q, w, 3 | (1 << K.WRENCH_SHIFT),
+                                   ws.ws, tau),
+    lambda: K.run_gravity_torques(P, q, ws.ws, tau),
+    lambda: K.run_mass_matrix_crba(P, q, ws.ws, D),
+    lambda: K.run_mass_matrix(P, q, False, ws.ws, ws.scratch, D),
+    lambda: K.run_coriolis_matrix(P, q, q, True, ws.ws, ws.cw, ws.scratch, D),
+    lambda: K.run_coriolis_matrix(P, q, q, False, ws.ws, ws.cw, ws.scratch,
+                                  D),
+    lambda: K.run_forward_dynamics(P, q, q, q, w, 3, ws.ws, ws.aw, tau),
+    lambda: K.run_jacobian(P, q, True, ws.ws, ws.frames, J),
+    lambda: K.run_link_poses(P, q, ws.ws, ws.frames),
+    lambda: K.run_inverse_dynamics_batch(P, Q, Q, Q, W, 3, ws.ws, out,
+                                         ws.status),
+    lambda: K.run_forward_dynamics_batch(P, Q, Q, Q, W, 3, ws.ws, ws.aw, out,
+                                         ws.status),
+    lambda: K.run_mass_matrix_batch(P, Q, ws.ws, DD, ws.status),
+    lambda: K.run_gravity_torques_batch(P, Q, ws.ws, out, ws.status),
+    lambda: K.run_coriolis_matrix_batch(P, Q, Q, ws.ws, ws.cw, DD, ws.status),
+]
+for call in calls:
+    assert call() == -1                 # compiled (or loaded), and succeeds
+before = rtsys.get_allocation_stats()
+for _ in range(10):
+    for call in calls:
+        call()
+after = rtsys.get_allocation_stats()
+# numba's allocator counts every array the compiled code creates (the
+# entry points pass arrays in without wrapping them: _jit.ENTRY)
+print(after.alloc - before.alloc)
 """
 
 
