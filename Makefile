@@ -26,9 +26,11 @@ PYTEST_ARGS ?=
 # Tests must not see (or be seen by) ROS 2 nodes on other hosts; override on
 # the command line only if you mean it (make test ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET).
 export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
-# Keep rclpy's log files and numba's JIT cache inside the (ignored) build dir.
+# Keep rclpy's log files inside the (ignored) build dir, and numba's JIT
+# cache where the package keeps it anyway, in the user's cache: a fresh
+# clone of the same sources compiles nothing (core/kernels/_jit.py).
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
-export NUMBA_CACHE_DIR := $(CURDIR)/build/numba-cache
+export NUMBA_CACHE_DIR ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/newton_euler_ros/numba
 
 .PHONY: setup test demo demo-pick demo-identify bench bench-identify latency \
 	peers accuracy \

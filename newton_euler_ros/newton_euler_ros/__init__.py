@@ -25,7 +25,7 @@ __version__ = '0.1.0'
 
 # numba caches compiled kernels beside the source by default, which puts
 # them in the source tree (or fails in a read-only install).  Unless the
-# caller chose a place (the Makefile uses build/numba-cache), keep them in
+# caller chose a place, keep them (as the Makefile does) in
 # the user's cache directory; set before anything imports numba.
 os.environ.setdefault('NUMBA_CACHE_DIR', os.path.join(
     os.environ.get('XDG_CACHE_HOME') or os.path.join(

@@ -94,8 +94,6 @@ def scratch_root(tmp_path):
 
 def _env(page):
     env = ros_env(domain_id(13 + PAGES.index(page)))
-    env.setdefault('NUMBA_CACHE_DIR', os.path.join(ROOT, 'build',
-                                                   'numba-cache'))
     env.pop('MAKEFLAGS', None)
     env.pop('MAKELEVEL', None)
     return env
@@ -134,10 +132,18 @@ def _stop_after(proc, seconds, where):
     return proc.returncode, out
 
 
-def run_page(page, cwd):
-    """Run every block of one page in order; return how many ran."""
+def run_page(page, cwd, passed=None):
+    """
+    Run every block of one page in order; return how many ran.
+
+    ``passed``: the texts of the blocks that already ran and passed in
+    ``cwd`` (pages share one root in the suite: the README and the
+    identification pages run the same commands on the same files, and an
+    identical command is run once); each block run here is added.
+    """
     ran = 0
     env = _env(page)
+    passed = set() if passed is None else passed
     for line, lang, directive, text in blocks(page):
         if lang not in RUN or RUN[lang] is None:
             continue
@@ -150,6 +156,8 @@ def run_page(page, cwd):
         if directive and directive.startswith('skip'):
             assert re.match(r'skip \(.+\)', directive), (
                 f'{where}: a skipped block must say why: skip (REASON)')
+            continue
+        if text in passed:
             continue
         proc = subprocess.Popen(
             _command(lang, text, str(cwd)), cwd=str(cwd), env=env,
@@ -171,6 +179,7 @@ def run_page(page, cwd):
             code = proc.returncode
         assert code == 0, (f'{where}: exit status {code} for\n{text}\n'
                            f'output:\n{out[-4000:]}')
+        passed.add(text)
         ran += 1
     return ran
 
@@ -184,10 +193,17 @@ def test_block_parser_reads_directives():
     assert text and all(lang is not None for _, lang, _, _ in text)
 
 
+@pytest.fixture(scope='module')
+def shared_root(tmp_path_factory):
+    """One scratch root for every page, and the blocks passed in it."""
+    return scratch_root(tmp_path_factory.mktemp('pages')), set()
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize('page', PAGES)
-def test_every_command_on_the_page_works_as_pasted(page, tmp_path):
-    run_page(page, scratch_root(tmp_path))
+def test_every_command_on_the_page_works_as_pasted(page, shared_root):
+    root, passed = shared_root
+    run_page(page, root, passed)
 
 
 def _page(name):

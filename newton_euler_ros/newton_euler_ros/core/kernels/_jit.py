@@ -31,8 +31,22 @@ A compiled module outside the package that calls kernel functions (the
 momentum observer) registers its file with :func:`uses_kernels` before
 its functions are decorated: its functions are then stamped with its own
 file and all the kernel files.
+
+The stamps are the files' contents (numba hashes a function's own file;
+the package stamp hashes the kernel files the same way), and every
+compiled function of the package is cached under a directory named by
+its place in the package, not by the absolute path of the source (numba's
+default), and by the digest of the sources it is stamped with
+(:func:`cache_subpath`): a fresh clone of the same sources finds the
+compilations of the last one (``make`` keeps them in the user's cache);
+an edited file recompiles only what it stamps, in a directory of its own;
+kernel caches of older sources are removed after a day, the four newest
+kept.
 """
+import hashlib
 import os
+import shutil
+import time
 
 try:  # a copy of the kernels (highprec, the type-map test) injects its own
     njit = __njit_override__  # noqa: F821
@@ -52,6 +66,7 @@ except NameError:
 ENTRY = {'cache': True, '_nrt': False}
 
 _DIR = os.path.dirname(os.path.abspath(__file__))
+_ROOT = os.path.dirname(os.path.dirname(_DIR))   # the newton_euler_ros package
 _USERS = set()      # files outside the package whose functions call kernels
 
 
@@ -61,17 +76,65 @@ def uses_kernels(path):
 
 
 def package_stamp():
-    """Return (name, mtime, size) of every kernel source file, sorted."""
-    stamp = []
+    """Return the SHA-256 of every kernel source file's name and bytes."""
+    digest = hashlib.sha256()
     for name in sorted(os.listdir(_DIR)):
         if name.endswith('.py'):
-            st = os.stat(os.path.join(_DIR, name))
-            stamp.append((name, st.st_mtime, st.st_size))
-    return tuple(stamp)
+            with open(os.path.join(_DIR, name), 'rb') as f:
+                data = f.read()
+            digest.update(f'{name}\0{len(data)}\0'.encode())
+            digest.update(data)
+    return digest.hexdigest()
+
+
+def _file_digest(path):
+    with open(path, 'rb') as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def cache_subpath(py_file, stamp):
+    """
+    Return the cache directory name of a function in ``py_file``.
+
+    In the package: ``newton_euler_ros.<its folder>-<digest>``, the digest
+    that of the kernel files (``stamp``) for a function stamped with them,
+    else of its own file: the same for every checkout of the same sources,
+    and never shared by two versions of them (two checkouts compiling at
+    once cannot read each other's files).  Elsewhere None (numba's own
+    name, from the absolute path).
+    """
+    path = os.path.abspath(py_file)
+    rel = os.path.relpath(os.path.dirname(path), _ROOT)
+    if rel.startswith(os.pardir) or os.path.isabs(rel):
+        return None
+    place = 'newton_euler_ros' + ('' if rel == os.curdir else
+                                  '.' + rel.replace(os.sep, '.'))
+    try:
+        digest = (stamp if os.path.dirname(path) == _DIR or path in _USERS
+                  else _file_digest(path))
+    except OSError:
+        return None
+    return f'{place}-{digest[:16]}'
+
+
+def _prune(cache_dir, current, keep=4, min_age=86400.0):
+    """Remove all but the newest ``keep`` kernel caches a day old or more."""
+    place = current.rsplit('-', 1)[0] + '-'
+    try:
+        names = [n for n in os.listdir(cache_dir)
+                 if n.startswith(place) and n != current]
+        dated = sorted(((os.stat(os.path.join(cache_dir, n)).st_mtime, n)
+                        for n in names), reverse=True)
+    except OSError:
+        return
+    now = time.time()
+    for mtime, name in dated[keep - 1:]:
+        if now - mtime >= min_age:
+            shutil.rmtree(os.path.join(cache_dir, name), ignore_errors=True)
 
 
 def _install_package_stamp():
-    """Stamp cached kernel functions with every kernel file (see above)."""
+    """Stamp and place the package's cached functions (see above)."""
     from numba.core import caching
 
     stamp = package_stamp()
@@ -80,13 +143,19 @@ def _install_package_stamp():
         class Locator(base):
             @classmethod
             def from_function(cls, py_func, py_file):
-                path = os.path.abspath(py_file)
-                if os.path.dirname(path) != _DIR and path not in _USERS:
-                    return None
+                if cache_subpath(py_file, stamp) is None:
+                    return None         # not ours: numba's own locators
                 return super().from_function(py_func, py_file)
+
+            @classmethod
+            def get_suitable_cache_subpath(cls, py_file):
+                return cache_subpath(py_file, stamp)
 
             def get_source_stamp(self):
                 own = super().get_source_stamp()    # this function's file
+                path = os.path.abspath(self._py_file)
+                if os.path.dirname(path) != _DIR and path not in _USERS:
+                    return own
                 return (stamp, own)
 
         Locator.__name__ = f'KernelPackage{base.__name__}'
@@ -102,6 +171,10 @@ def _install_package_stamp():
                  caching.InTreeCacheLocator,
                  caching.UserWideCacheLocator]
         classes[:0] = [stamped(b) for b in bases]
+    from numba.core import config
+    if config.CACHE_DIR:
+        _prune(config.CACHE_DIR, cache_subpath(os.path.join(_DIR, '_jit.py'),
+                                               stamp))
 
 
 if not _COPY:
