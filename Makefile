@@ -22,6 +22,9 @@ SHELL := /bin/bash
 VENV := .venv
 PY   := $(VENV)/bin/python
 PYTEST_ARGS ?=
+# Two test processes, one test file each at a time (pytest-xdist): the node
+# tests mostly wait on DDS; make test PYTEST_WORKERS= runs them in one.
+PYTEST_WORKERS ?= -n 2 --dist loadfile
 
 # Tests must not see (or be seen by) ROS 2 nodes on other hosts; override on
 # the command line only if you mean it (make test ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET).
@@ -40,7 +43,7 @@ setup:
 	@bash scripts/setup_env.sh
 
 test: setup
-	NEWTON_EULER_NO_SKIPS=1 $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_ARGS)
+	NEWTON_EULER_NO_SKIPS=1 $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 demo: setup
 	$(PY) -m newton_euler_tools.demo

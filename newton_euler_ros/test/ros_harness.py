@@ -33,15 +33,17 @@ def domain_id(offset):
     """
     Return a domain id unique to this test run and module (1..100).
 
-    Under pytest-xdist (``make test`` runs two workers) worker k takes
-    ids from its own half, 50 k + 1 .. 50 k + 40, leaving ten above each
-    for the tools that use consecutive ids (demos, latency phases), so
-    two workers never share a domain.
+    Under pytest-xdist (``make test`` runs two workers) worker k of K
+    takes ids from its own slice of 100 // K, the top ten of each left
+    for the tools that use consecutive ids (demos, latency phases), so two
+    workers never share a domain.
     """
     worker = os.environ.get('PYTEST_XDIST_WORKER', '')
-    if worker.startswith('gw') and worker[2:].isdigit():
-        half = int(worker[2:]) % 2
-        return 1 + 50 * half + (os.getpid() * 7 + offset) % 40
+    count = os.environ.get('PYTEST_XDIST_WORKER_COUNT', '')
+    if worker[2:].isdigit() and count.isdigit() and int(count) > 1:
+        size = 100 // min(int(count), 5)
+        k = int(worker[2:]) % min(int(count), 5)
+        return 1 + size * k + (os.getpid() * 7 + offset) % (size - 10)
     return 1 + (os.getpid() * 7 + offset) % 100
 
 
