@@ -59,7 +59,6 @@ import time
 from newton_euler_ros.core import NewtonEulerError
 import numpy as np
 
-from .. import peers
 from .measure import (first_call_times, measure_batches, measure_inputs,
                       measure_probes, measure_single, Timer)
 from .prepare import (BATCH_STATES, BATCHES, DEFAULT_ROBOTS, OPS,
@@ -69,6 +68,7 @@ from .references import check_references, naive_mass_matrix, naive_rnea
 from .report import (json_default, jsonable, loadavg, print_breakdown,
                      print_first_call, print_inputs, print_misses,
                      print_table, verdicts)
+from .. import peers
 
 __all__ = ['BATCH_STATES', 'BATCHES', 'bench_robot', 'DEFAULT_ROBOTS',
            'first_call_times', 'main', 'naive_mass_matrix', 'naive_rnea',

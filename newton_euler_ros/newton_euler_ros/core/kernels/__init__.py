@@ -63,12 +63,12 @@ import os
 import sys
 import types
 
+from . import entry as _entry
 from ._jit import ENTRY
 from .aba import articulated_body
 from .cholesky import cholesky_solve
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
-from . import entry as _entry
 from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
