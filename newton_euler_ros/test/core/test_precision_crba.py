@@ -285,6 +285,7 @@ def _run_every_kernel(mod, model, dtype):
     x = np.zeros(n, f)
     assert mod.cholesky_solve(D, q, np.zeros((n, n), f), x) == -1
     mod.round_into(q, x)
+    assert mod.check_finite(q, q, q, w) == -1     # Float32Dynamics calls it
 
 
 @pytest.fixture(scope='module')

@@ -38,8 +38,10 @@ file                   what it holds
 ``status.py``          finiteness checks and status codes in the kernels
 ``layout.py``          every array column by name (``L_*``, ``F_*``,
                        ``W_*``, ``A_*``, ``CW_*``), flags, status codes
-``entry.py``           what Python calls: one entry point per term and its
-                       batch loop beside it, checking sizes and values
+``entry.py``           what Python calls: each term once, as its row step,
+                       and one registration making its entry point and
+                       batch loop
+``generate.py``        writes those: size and finiteness checks, the loop
 ``_jit.py``            ``njit``, the entry options, on-disk caching
 =====================  ====================================================
 
@@ -61,18 +63,12 @@ import os
 import sys
 import types
 
+from . import entry as _entry
 from ._jit import ENTRY
 from .aba import articulated_body
 from .cholesky import cholesky_solve
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
-from .entry import (run_coriolis_matrix, run_coriolis_matrix_batch,
-                    run_forward_dynamics, run_forward_dynamics_batch,
-                    run_gravity_torques, run_gravity_torques_batch,
-                    run_inverse_dynamics, run_inverse_dynamics_batch,
-                    run_jacobian, run_link_poses, run_mass_matrix,
-                    run_mass_matrix_batch, run_mass_matrix_crba,
-                    run_regressor_batch)
 from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
@@ -98,20 +94,22 @@ __all__ = [
     'jacobian', 'joint_trig', 'L_BODY', 'L_COM', 'L_INERTIA', 'L_MASS',
     'L_P', 'L_R', 'L_TYPE', 'L_WIDTH', 'mass_matrix_columns',
     'mass_matrix_crba', 'NONFINITE', 'OVERFLOW', 'pack', 'recursion',
-    'round_into', 'run_coriolis_matrix', 'run_coriolis_matrix_batch',
-    'run_forward_dynamics', 'run_forward_dynamics_batch',
-    'run_gravity_torques', 'run_gravity_torques_batch',
-    'run_inverse_dynamics', 'run_inverse_dynamics_batch', 'run_jacobian',
-    'run_link_poses', 'run_mass_matrix', 'run_mass_matrix_batch',
-    'run_mass_matrix_crba', 'run_regressor_batch', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
+    'round_into', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
     'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
     'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',
 ]
 
+# every entry point of entry.py (``run_<term>``, ``run_<term>_batch``):
+# registering a term there is all it takes to export it from here
+RUN = {name: f for name, f in vars(_entry).items()
+       if name.startswith('run_')}
+globals().update(RUN)
+__all__ += sorted(RUN)
+
 # the kernel files in the order they import each other
 MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
            'newton_euler', 'crba', 'coriolis', 'aba', 'regressor',
-           'entry')
+           'generate', 'entry')
 _DIR = os.path.dirname(os.path.abspath(__file__))
 
 

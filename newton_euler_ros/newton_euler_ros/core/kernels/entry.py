@@ -13,35 +13,49 @@
 # limitations under the License.
 
 """
-Entry points: what Python calls, one per term, each with its batch loop.
+Entry points: what Python calls, each term written once as its row step.
 
-Each takes the model packed into one array (``layout.pack``), the switches
-as one integer (``layout.flags``), checks every size against the model
-(numba does not check bounds) and every input for finiteness, and
-returns a status code (``layout``: -1 success, ``NONFINITE * a + i``,
-``SIZE + a``, ``OVERFLOW``, ``SINGULAR + j``).  Few arguments, because
-numba's dispatcher costs about 40 ns per argument.  They are compiled
-with ``_jit.ENTRY`` (no reference-counting runtime: see there).
+A term is its *row step*, ``<term>_row(links, frames, <arguments>)``: the
+kernel call on one state, returning a status code (``layout``: -1
+success, ``OVERFLOW``, ``SINGULAR + j``, or the kernel's own).  One
+registration line below makes from it the single-state entry point
+``run_<term>`` (:func:`generate.entry`: every size checked against the
+model, since numba does not check bounds, and every input for
+finiteness: ``SIZE + a``, ``NONFINITE * a + i``) and, where the term has
+one, the batch loop ``run_<term>_batch`` (:func:`generate.batch`: the
+row step on each row of (m, n) arrays; the caller checks shapes and
+finiteness in numpy, once per batch; it returns -1, or the first row
+that failed with its code in ``status[0]``).  The entry points take the
+model packed into one array (``layout.pack``) and the switches as one
+integer (``layout.flags``): few arguments, because numba's dispatcher
+costs about 40 ns per argument.  They are compiled with ``_jit.ENTRY``
+(no reference-counting runtime: see there).  ``generate.SOURCES`` holds
+the text of each.
 
-Batches: one compiled loop over the rows of (m, n) arrays of states,
-beside the single-state entry point of the same term.  The caller checks
-shapes and finiteness (numpy, once per batch); each returns -1, or the
-first row that failed (its code in ``status[0]``).
-
-Adding a term: its kernel in the file of its pass, ``run_<term>`` and
-``run_<term>_batch`` here, and one line in ``dynamics._ENTRIES``.
+Adding a term: its kernel in the file of its pass; its row step here;
+and its registration lines at the end of this file
+(``run_<term> = entry(<term>_row)``, ``run_<term>_batch =
+batch(<term>_row)``).  The row step's argument names say what each is
+(``generate.SHAPES``: a new kind of array gets a line there).  Then its
+strict entry and public function in ``core/dynamics.py``, its batch
+function in ``core/batch.py``.
 """
 from ._jit import ENTRY, njit
 from .aba import articulated_body
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
+from .generate import batch, entry
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, OVERFLOW, SINGULAR,
-                     SIZE, VELOCITY, W_WIDTH, WRENCH_SHIFT)
+from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, NONFINITE,  # noqa
+                     OVERFLOW, SINGULAR, SIZE, VELOCITY, W_WIDTH,
+                     WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
                            mass_matrix_columns, recursion)
 from .regressor import drive_columns, regressor_columns
-from .status import check_finite, first_bad_row, first_nonfinite, matrix_status
+from .status import first_nonfinite, matrix_status
+
+# A_WIDTH, CW_WIDTH, NONFINITE, SIZE and W_WIDTH are read by the generated
+# checks (generate.SHAPES), from this module's globals.
 
 
 @njit(cache=True)
@@ -50,56 +64,12 @@ def _split(P):
     return P[:n], P[n:]
 
 
-@njit(cache=True)
-def _sizes(n, q, qd, qdd, wrench, ws, ws_width):
-    """SIZE + a for the first argument of the wrong size, else -1."""
-    if q.shape[0] != n:
-        return SIZE
-    if qd.shape[0] != n:
-        return SIZE + 1
-    if qdd.shape[0] != n:
-        return SIZE + 2
-    if wrench.shape[0] != 6:
-        return SIZE + 3
-    if ws.shape[0] < n or ws.shape[1] != ws_width:
-        return SIZE + 5
-    return -1
-
+# ---------------------------------------------------------------------------
+# the row steps: each term on one state (sizes and finiteness checked)
 
 @njit(cache=True, inline='always')
-def _split_checked(P, q, ws):
-    """
-    Return (links, frames, status) for an entry point taking q only.
-
-    status is -1, or the code of q's size, the workspace's size or q's
-    first non-finite entry.  (frames[0, :6] stands for a wrench: a
-    6-vector, always finite.)
-    """
-    links, frames = _split(P)
-    bad = _sizes(links.shape[0], q, q, q, frames[0, :6], ws, W_WIDTH)
-    if bad < 0:
-        bad = first_nonfinite(q)
-    return links, frames, bad
-
-
-@njit(cache=True)
-def _square(M, n):
-    return M.shape[0] == n and M.shape[1] == n
-
-
-@njit(**ENTRY)
-def run_inverse_dynamics(P, q, qd, qdd, wrench, flags, ws, tau):
+def inverse_dynamics_row(links, frames, q, qd, qdd, wrench, flags, ws, tau):
     """tau(q, qd, qdd, F_e); ``flags`` selects gravity, velocity, wrench."""
-    links, frames = _split(P)
-    n = links.shape[0]
-    bad = _sizes(n, q, qd, qdd, wrench, ws, W_WIDTH)
-    if bad >= 0:
-        return bad
-    if tau.shape[0] != n:
-        return SIZE + 4
-    bad = check_finite(q, qd, qdd, wrench)
-    if bad >= 0:
-        return bad
     joint_trig(links, frames, q, ws)
     recursion(links, frames, qd, qd, qdd, wrench, (flags & GRAVITY) != 0,
               (flags & VELOCITY) != 0, flags >> WRENCH_SHIFT, ws, tau)
@@ -108,185 +78,74 @@ def run_inverse_dynamics(P, q, qd, qdd, wrench, flags, ws, tau):
     return -1
 
 
-@njit(**ENTRY)
-def run_inverse_dynamics_batch(P, Q, QD, QDD, W, flags, ws, TAU, status):
-    """Compute tau for each row (the inputs are finite: checked in numpy)."""
-    links, frames = _split(P)
-    gravity_on = (flags & GRAVITY) != 0
-    velocity_on = (flags & VELOCITY) != 0
-    mode = flags >> WRENCH_SHIFT
-    for k in range(Q.shape[0]):
-        joint_trig(links, frames, Q[k], ws)
-        recursion(links, frames, QD[k], QD[k], QDD[k], W[k], gravity_on,
-                  velocity_on, mode, ws, TAU[k])
-    return first_bad_row(TAU, status)
-
-
-@njit(**ENTRY)
-def run_gravity_torques(P, q, ws, tau):
-    """g(q): ``run_inverse_dynamics`` at rest with gravity, fewer arguments."""
-    links, frames, bad = _split_checked(P, q, ws)
-    if bad >= 0:
-        return bad
-    n = links.shape[0]
-    if tau.shape[0] != n:
-        return SIZE + 4
+@njit(cache=True, inline='always')
+def gravity_torques_row(links, frames, q, ws, tau):
+    """g(q): the recursion at rest with gravity, fewer arguments."""
     gravity(links, frames, q, ws, tau)
     if first_nonfinite(tau) >= 0:
         return OVERFLOW
     return -1
 
 
-@njit(**ENTRY)
-def run_gravity_torques_batch(P, Q, ws, G, status):
-    """Compute g for each row (see ``run_gravity_torques``)."""
-    links, frames = _split(P)
-    for k in range(Q.shape[0]):
-        gravity(links, frames, Q[k], ws, G[k])
-    return first_bad_row(G, status)
-
-
-@njit(**ENTRY)
-def run_mass_matrix_crba(P, q, ws, D):
-    """D(q) by CRBA: ``run_mass_matrix`` with fewer arguments."""
-    links, frames, bad = _split_checked(P, q, ws)
-    if bad >= 0:
-        return bad
-    n = links.shape[0]
-    if not _square(D, n):
-        return SIZE + 4
+@njit(cache=True, inline='always')
+def mass_matrix_crba_row(links, frames, q, ws, D):
+    """D(q) by CRBA."""
     return mass_matrix_crba(links, frames, q, ws, D)
 
 
-@njit(**ENTRY)
-def run_mass_matrix(P, q, crba, ws, scratch, D):
+@njit(cache=True, inline='always')
+def mass_matrix_row(links, frames, q, crba, ws, scratch, D):
     """D(q) by CRBA (``crba``) or by n recursions."""
-    links, frames, bad = _split_checked(P, q, ws)
-    if bad >= 0:
-        return bad
-    n = links.shape[0]
-    if not _square(D, n):
-        return SIZE + 4
-    if scratch.shape[0] != 3 or scratch.shape[1] < n:
-        return SIZE + 5
     if crba:
         return mass_matrix_crba(links, frames, q, ws, D)
     return mass_matrix_columns(links, frames, q, ws, scratch, D)
 
 
-@njit(**ENTRY)
-def run_mass_matrix_batch(P, Q, ws, DD, status):
-    """D for each row, by CRBA."""
-    links, frames = _split(P)
-    for k in range(Q.shape[0]):
-        code = mass_matrix_crba(links, frames, Q[k], ws, DD[k])
-        if code >= 0:
-            status[0] = code
-            return k
-    return -1
+@njit(cache=True, inline='always')
+def coriolis_matrix_composite_row(links, frames, q, qd, ws, cw, C):
+    """C(q, qd) by composite bodies, O(n^2)."""
+    return coriolis_matrix_composite(links, frames, q, qd, ws, cw, C)
 
 
-@njit(**ENTRY)
-def run_coriolis_matrix(P, q, qd, composite, ws, cw, scratch, C):
+@njit(cache=True, inline='always')
+def coriolis_matrix_row(links, frames, q, qd, composite, ws, cw, scratch, C):
     """C(q, qd) by composite bodies (``composite``) or n recursions."""
-    links, frames = _split(P)
-    n = links.shape[0]
-    bad = _sizes(n, q, qd, q, frames[0, :6], ws, W_WIDTH)
-    if bad >= 0:
-        return bad
-    if not _square(C, n):
-        return SIZE + 4
-    if (cw.shape[0] < n + 1 or cw.shape[1] != CW_WIDTH
-            or scratch.shape[0] != 3 or scratch.shape[1] < n):
-        return SIZE + 5
-    bad = check_finite(q, qd, q, frames[0, :6])
-    if bad >= 0:
-        return bad
     if composite:
         return coriolis_matrix_composite(links, frames, q, qd, ws, cw, C)
     return coriolis_matrix_columns(links, frames, q, qd, ws, scratch, C)
 
 
-@njit(**ENTRY)
-def run_coriolis_matrix_batch(P, Q, QD, ws, cw, CC, status):
-    """C for each row, by composite bodies (O(n^2) each)."""
-    links, frames = _split(P)
-    for k in range(Q.shape[0]):
-        code = coriolis_matrix_composite(links, frames, Q[k], QD[k], ws, cw,
-                                         CC[k])
-        if code >= 0:
-            status[0] = code
-            return k
-    return -1
-
-
-@njit(**ENTRY)
-def run_forward_dynamics(P, q, qd, tau, wrench, flags, ws, aw, qdd):
+# not inlined into its entry point (numba's inline='always'): the
+# articulated-body algorithm is itself inlined into this one function,
+# and the entry point inlining it all measured 13 % slower than calling it
+@njit(cache=True)
+def forward_dynamics_row(links, frames, q, qd, tau, wrench, flags, ws, aw,
+                         qdd):
     """Compute qdd by the articulated-body algorithm (``articulated_body``)."""
-    links, frames = _split(P)
-    n = links.shape[0]
-    bad = _sizes(n, q, qd, tau, wrench, ws, W_WIDTH)
-    if bad >= 0:
-        return bad
-    if qdd.shape[0] != n:
-        return SIZE + 4
-    if aw.shape[0] < n + 1 or aw.shape[1] != A_WIDTH:
-        return SIZE + 5
-    bad = check_finite(q, qd, tau, wrench)
-    if bad >= 0:
-        return bad
     bad = articulated_body(links, frames, q, qd, tau, wrench,
                            (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
                            flags >> WRENCH_SHIFT, ws, aw, qdd)
-    if 0 <= bad < n:
+    if 0 <= bad < links.shape[0]:
         return SINGULAR + bad
     return bad
 
 
-@njit(**ENTRY)
-def run_forward_dynamics_batch(P, Q, QD, TAU, W, flags, ws, aw, QDD,
-                               status):
-    """Compute qdd for each row by the articulated-body algorithm."""
-    links, frames = _split(P)
-    n = links.shape[0]
-    for k in range(Q.shape[0]):
-        code = articulated_body(links, frames, Q[k], QD[k], TAU[k], W[k],
-                                (flags & GRAVITY) != 0,
-                                (flags & VELOCITY) != 0,
-                                flags >> WRENCH_SHIFT, ws, aw, QDD[k])
-        if code >= 0:
-            status[0] = SINGULAR + code if code < n else code
-            return k
-    return -1
-
-
-@njit(**ENTRY)
-def run_jacobian(P, q, in_ee_axes, ws, Ts, J):
+@njit(cache=True, inline='always')
+def jacobian_row(links, frames, q, in_ee_axes, ws, Ts, J):
     """J(q), 6 x n (see ``jacobian``)."""
-    links, frames, bad = _split_checked(P, q, ws)
-    if bad >= 0:
-        return bad
-    n = links.shape[0]
-    if J.shape[0] != 6 or J.shape[1] != n:
-        return SIZE + 4
-    if Ts.shape[0] != n + 2 or Ts.shape[1] != 12:
-        return SIZE + 5
     jacobian(links, frames, q, in_ee_axes, ws, Ts, J)
     return matrix_status(J)
 
 
-@njit(**ENTRY)
-def run_link_poses(P, q, ws, Ts):
+@njit(cache=True, inline='always')
+def link_poses_row(links, frames, q, ws, Ts):
     """Poses of frame 0, the link frames and the end effector (``Ts``)."""
-    links, frames, bad = _split_checked(P, q, ws)
-    if bad >= 0:
-        return bad
-    n = links.shape[0]
-    if Ts.shape[0] != n + 2 or Ts.shape[1] != 12:
-        return SIZE + 5
     forward_kinematics(links, frames, q, ws, Ts)
     return matrix_status(Ts)
 
+
+# the regressor has a batch form only, and checks its own sizes (its
+# scratch comes from its caller, not from a Workspace)
 
 @njit(**ENTRY)
 def run_regressor_batch(P, Q, QD, QDD, drives, eps, ws, line, acc, Y):
@@ -316,3 +175,22 @@ def run_regressor_batch(P, Q, QD, QDD, drives, eps, ws, line, acc, Y):
         if drives:
             drive_columns(frames, QD[i], QDD[i], eps, Y[i])
     return -1
+
+
+# ---------------------------------------------------------------------------
+# the registrations: one entry point (and batch loop) per row step
+
+run_inverse_dynamics = entry(inverse_dynamics_row)
+run_inverse_dynamics_batch = batch(inverse_dynamics_row)
+run_gravity_torques = entry(gravity_torques_row)
+run_gravity_torques_batch = batch(gravity_torques_row)
+run_mass_matrix_crba = entry(mass_matrix_crba_row)
+run_mass_matrix_batch = batch(mass_matrix_crba_row, 'run_mass_matrix_batch')
+run_mass_matrix = entry(mass_matrix_row)
+run_coriolis_matrix = entry(coriolis_matrix_row)
+run_coriolis_matrix_batch = batch(coriolis_matrix_composite_row,
+                                  'run_coriolis_matrix_batch')
+run_forward_dynamics = entry(forward_dynamics_row)
+run_forward_dynamics_batch = batch(forward_dynamics_row)
+run_jacobian = entry(jacobian_row)
+run_link_poses = entry(link_poses_row)

@@ -59,16 +59,6 @@ def matrix_status(X):
     return -1
 
 
-@njit(cache=True, inline='always')
-def first_bad_row(X, status):
-    """Index of the first row of X with a non-finite entry (status set)."""
-    for k in range(X.shape[0]):
-        if first_nonfinite(X[k]) >= 0:
-            status[0] = OVERFLOW
-            return k
-    return -1
-
-
 @njit(cache=True)
 def round_into(x, out):
     """

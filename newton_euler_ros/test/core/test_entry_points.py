@@ -1,0 +1,111 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The entry points written from the row steps keep the kernels' contract.
+
+Each single-state entry point returns ``SIZE + a`` for input a of the
+wrong size (4 the output, 5 a workspace) and ``NONFINITE * a + i`` for
+the first non-finite entry of input a; each batch loop returns the first
+failing row with its code in ``status[0]`` (the codes that
+``calling.status_error`` decodes).
+"""
+import inspect
+
+from newton_euler_ros.core import kernels as K
+from newton_euler_ros.core import load_robot, Workspace
+from newton_euler_ros.core.kernels import generate
+import numpy as np
+import pytest
+
+
+@pytest.fixture(scope='module')
+def args():
+    """Arguments for every entry point, by name, for a 2-joint arm."""
+    model = load_robot('planar_2r')
+    n = model.n
+    ws = Workspace(model)
+    q = np.array([0.3, -0.2])
+    return model, {
+        'P': model.packed, 'q': q, 'qd': q.copy(), 'qdd': q.copy(),
+        'tau': q.copy(), 'wrench': np.zeros(6), 'flags': 3, 'crba': True,
+        'composite': True, 'in_ee_axes': False, 'ws': ws.ws, 'aw': ws.aw,
+        'cw': ws.cw, 'scratch': ws.scratch, 'Ts': ws.frames,
+        'D': np.empty((n, n)), 'C': np.empty((n, n)), 'J': np.empty((6, n)),
+    }
+
+
+def _call(name, given, **changed):
+    kernel = K.RUN[name]
+    params = list(inspect.signature(kernel.py_func).parameters)
+    values = dict(given, **changed)
+    if params[-1] in ('tau', 'qdd'):      # the output of tau, g, fd
+        values[params[-1]] = np.empty(len(given['q']))
+    return kernel(*[values[p] for p in params])
+
+
+SINGLE = [name for name in generate.SOURCES if not name.endswith('_batch')]
+
+
+def test_every_entry_point_but_the_regressor_is_generated():
+    assert set(K.RUN) == set(generate.SOURCES) | {'run_regressor_batch'}
+    for name, kernel in K.RUN.items():
+        assert kernel.py_func.__name__ == name
+
+
+@pytest.mark.parametrize('name', SINGLE)
+def test_sizes_and_non_finite_inputs_give_the_same_codes(args, name):
+    model, given = args
+    assert _call(name, given) == -1
+    params = list(inspect.signature(K.RUN[name].py_func).parameters)
+    for a, arg in enumerate(('q', 'qd', 'qdd' if 'qdd' in params[:-1]
+                             else 'tau', 'wrench')):
+        if arg not in params[:-1]:
+            continue
+        bad = np.append(given[arg], 0.0)
+        assert _call(name, given, **{arg: bad}) == K.SIZE + a, arg
+        nan = given[arg].copy()
+        nan[1] = np.nan
+        assert _call(name, given, **{arg: nan}) == K.NONFINITE * a + 1, arg
+    small = np.zeros((1, K.W_WIDTH))
+    assert _call(name, given, ws=small) == K.SIZE + 5
+
+
+def test_batch_loops_return_the_first_failing_row():
+    model = load_robot('planar_rp')
+    ws = Workspace(model)
+    Q = np.zeros((3, 2))
+    Q[1, 1] = 1e200         # a prismatic joint: D overflows
+    DD = np.empty((3, 2, 2))
+    assert K.run_mass_matrix_batch(model.packed, Q, ws.ws, DD,
+                                   ws.status) == 1
+    assert ws.status[0] == K.OVERFLOW
+    Q[1, 1] = np.nan        # (the callers check finiteness first)
+    TAU = np.empty((3, 2))
+    ws.status[0] = -1
+    assert K.run_gravity_torques_batch(model.packed, Q, ws.ws, TAU,
+                                       ws.status) == 1
+    assert ws.status[0] == K.OVERFLOW
+    Q[1, 1] = 0.0
+    assert K.run_gravity_torques_batch(model.packed, Q, ws.ws, TAU,
+                                       ws.status) == -1
+
+
+def test_the_generated_text_is_kept_and_compiled_at_its_row_step():
+    text = generate.SOURCES['run_gravity_torques_batch']
+    assert 'gravity_torques_row(links, frames, Q[k], ws, TAU[k])' in text
+    code = K.run_gravity_torques.py_func.__code__
+    row = K.entry.gravity_torques_row.py_func.__code__
+    assert code.co_filename == row.co_filename
+    assert code.co_firstlineno == row.co_firstlineno
