@@ -25,35 +25,46 @@ centres of mass +-15 mm, inertias +-25 %: ``ident_example.perturb_urdf``),
 with joint friction (viscous + Coulomb) and rotor inertia the URDF does
 not have.  inverse_dynamics_node is given the published URDF.
 
-1. ``newton-euler excite`` writes an excitation trajectory.
+1. ``newton-euler excite`` writes an excitation trajectory (one period
+   of 8 s, 4 harmonics, 5 s of optimisation; ``--quick``: 5 s, 3, 4 s).
 2. It runs through the node (``~/trajectory_in`` -> ``~/trajectory_out``,
    efforts filled) into the simulator's ``~/joint_trajectory`` (PD + the
    points' effort, as joint_trajectory_controller); ``/joint_states`` is
    recorded by a subscriber and written to a rosbag2 (MCAP) with
    ``ident.bag``'s writer.
 3. ``newton-euler identify`` writes the corrected URDF.
-4. The same trajectory runs again, the node on the identified URDF with
-   ``drives.compensate:=true``.
-5. The plant picks up a payload (its ``payload.*`` parameters); a run
-   with the node not told is recorded, ``newton-euler payload --json``
-   estimates the payload from it, and a last run gives the estimate to
-   the node (its ``payload.*`` parameters).
+4. Two runs at once, each node given the identified URDF on
+   ``robot_description`` with ``drives.compensate:=true``: the same
+   trajectory as is, and with the plant holding a payload (its
+   ``payload.*`` parameters) the node is not told of, recorded.
+5. ``newton-euler payload --json`` estimates the payload from that
+   recording.
+6. A last run: the estimate goes to the node's ``payload.*`` in one
+   ``set_parameters_atomically`` call, and the trajectory runs again.
 
 Every run is a fresh pair of processes in a ROS domain of its own
-(``ROS_DOMAIN_ID`` from the environment as the first, if set), discovery
-limited to this host.  Writes ``summary.md`` (one table: feedforward
-torque error against the plant's true torque along the plan, and the
-tracking error, per run), ``tracking.png``, ``torques.png``, the files of
-every step (URDFs, trajectory, bags, the commands' output) and the nodes'
-logs to DIR (default out/demo_identify).
+(``ROS_DOMAIN_ID`` and the next three ids if it is set, else from
+1 + pid % 100), discovery limited to this host.  A run's processes start
+while an earlier step works (the first run's during ``excite``, the
+next two during the first run, the last during ``identify``); the
+simulator starts its clock only when the demo subscribes to its
+``/joint_states``, once the node has its model.  The commands run
+in this process through the console script's entry point, their output
+saved.  Writes ``summary.md`` (one table: feedforward torque error
+against the plant's true torque along the plan, and the tracking error,
+per run), ``summary.json`` (the figures and the wall time of each step),
+``tracking.png``, ``torques.png``, the files of every step (URDFs,
+trajectory, bags, the commands' output) and the nodes' logs to DIR
+(default out/demo_identify).
 """
 import argparse
+import contextlib
+import io
 import json
 import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import warnings
@@ -81,7 +92,7 @@ KD = [30.0, 30.0, 25.0, 25.0, 6.0, 6.0, 2.0]
 RATE = 250.0
 START = [0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]
 # excitation: period (s), periods, harmonics, optimisation budget (s)
-FULL = (6.0, 2, 4, 10.0)
+FULL = (8.0, 1, 4, 5.0)
 QUICK = (5.0, 1, 3, 4.0)
 
 
@@ -128,45 +139,31 @@ class Steps:
         self.times[key] = round(time.monotonic() - begun, 2)
 
 
-class NewtonEuler:
-    """``newton-euler ARGS`` started now; :meth:`result` waits for it."""
+def newton_euler(*args, log):
+    """
+    Run ``newton-euler ARGS``; write its output to ``log``, return stdout.
 
-    def __init__(self, *args, log):
-        self.args = [str(a) for a in args]
-        self.log = log
-        self._out = tempfile.TemporaryFile('w+', encoding='utf-8')
-        self._err = tempfile.TemporaryFile('w+', encoding='utf-8')
-        self.proc = subprocess.Popen(
-            [sys.executable, '-m', 'newton_euler_ros.cli', *self.args],
-            stdin=subprocess.DEVNULL, stdout=self._out, stderr=self._err,
-            text=True)
-
-    def result(self):
-        """Return its stdout; its output goes to ``log`` (DemoError on failure)."""
-        try:
-            self.proc.wait(timeout=600)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait()
-        out, err = self._out, self._err
-        out.seek(0)
-        err.seek(0)
-        stdout, stderr = out.read(), err.read()
-        out.close()
-        err.close()
-        with open(self.log, 'w', encoding='utf-8') as f:
-            f.write('$ newton-euler ' + ' '.join(self.args) + '\n')
-            f.write(stdout + stderr)
-        if self.proc.returncode != 0:
-            raise DemoError(f'newton-euler {self.args[0]} failed: '
-                            f'{stderr.strip()[-400:]}')
-        return stdout
-
-    def abort(self):
-        """Kill it if it still runs (the demo failed elsewhere)."""
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait()
+    The console script's entry point (``newton_euler_ros.cli.main``) runs
+    in this process, which has imported numba, scipy and the kernels
+    already: a process of its own would spend 2 to 4 s starting up.
+    DemoError when it fails.
+    """
+    from newton_euler_ros import cli
+    args = [str(a) for a in args]
+    out, err = io.StringIO(), io.StringIO()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = cli.main(args)
+    except SystemExit as exc:       # argparse on bad arguments
+        code = exc.code
+    stdout, stderr = out.getvalue(), err.getvalue()
+    with open(log, 'w', encoding='utf-8') as f:
+        f.write('$ newton-euler ' + ' '.join(args) + '\n')
+        f.write(stdout + stderr)
+    if code != 0:
+        raise DemoError(f'newton-euler {args[0]} failed: '
+                        f'{stderr.strip()[-400:]}')
+    return stdout
 
 
 def real_plant_urdf(text, links, seed):
@@ -256,9 +253,9 @@ class LoopRecorder(Recorder):
     recorder), so a run's processes can start well before it goes.
     """
 
-    def __init__(self, domain):
+    def __init__(self, domain, name):
         self.opened = False
-        super().__init__(domain)
+        super().__init__(domain, name=name)
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
         from rclpy.qos import (DurabilityPolicy, QoSProfile,
                                ReliabilityPolicy)
@@ -381,7 +378,8 @@ class LoopRun:
         self.sent = False
         self._stopper = None
         self.closed = False
-        self.rec = LoopRecorder(domain)
+        self.times = {'start': time.monotonic()}    # wall clock, per phase
+        self.rec = LoopRecorder(domain, f'demo_recorder_{label}')
         sim_args = ['-p', f'scene:={scene}', '-p', 'wait_for_subscribers:=2']
         if plant_payload:
             sim_args += [
@@ -425,6 +423,7 @@ class LoopRun:
     def go(self, segment):
         """Let the simulator start; the plan follows its start time."""
         self.segment = segment
+        self.times['go'] = time.monotonic()
         self.rec.open_states()
 
     def begun(self):
@@ -435,17 +434,22 @@ class LoopRun:
             rec.plan.publish(trajectory_message(_NAMES, rec.t0,
                                                 self.segment))
             self.sent = True
+            self.times['plan sent'] = time.monotonic()
         return self.sent
 
     def done(self, duration):
         """Return True once the simulation reached ``duration``."""
         t = self.rec.last_time()
-        return self.begun() and t is not None and t >= duration - 1e-9
+        if self.begun() and t is not None and t >= duration - 1e-9:
+            self.times.setdefault('end reached', time.monotonic())
+            return True
+        return False
 
     def finish(self, duration, bag=None):
         """Stop the processes (in a thread); return the recorded arrays."""
         rec = self.rec
         self.stop()
+        self.times['finish'] = time.monotonic()
         if not rec.filled:
             raise DemoError(f'[{self.label}] the simulator did not get the '
                             f'trajectory with efforts')
@@ -463,8 +467,13 @@ class LoopRun:
             if os.path.exists(bag):
                 shutil.rmtree(bag)
             write_joint_states(bag, ns[idx], rec.names, q, qd, effort)
+        self.times['recorded'] = time.monotonic()
         return {'t': t[idx], 'q': q, 'qd': qd, 'effort': effort,
                 'ff': np.array([p.effort for p in rec.filled[0].points])}
+
+    def timing(self, started):
+        """Return the wall time (s since ``started``) of each phase."""
+        return {k: round(v - started, 2) for k, v in self.times.items()}
 
     def stop(self):
         """Stop the processes, last started first, in a thread."""
@@ -554,6 +563,13 @@ def quiet_load(path):
         return load_robot(path, base=BASE, tip=TIP)
 
 
+def prepare_plots():
+    """Import matplotlib (Agg), a second or two, ahead of :func:`plot`."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot  # noqa: F401
+
+
 def plot(runs, segment, truth, out):
     """Tracking error and feedforward torque error per run."""
     import matplotlib
@@ -603,22 +619,21 @@ def main(argv=None):
     os.makedirs(log_dir, exist_ok=True)
     keep_bytecode(out)
     period, periods, harmonics, budget = QUICK if args.quick else FULL
-    steps = Steps(started)
-    live = []           # runs and commands to stop if anything fails
     try:
-        base = base_domain()
-        domains = iter(1 + (base - 1 + k) % 100 for k in range(4))
+        base = base_domain(4)
+    except ValueError as exc:
+        print(f'demo_identify: {exc}', file=sys.stderr)
+        return 2
+    steps = Steps(started)
+    live = []           # the runs to stop if anything fails
+    try:
+        domains = iter(range(base, base + 4))
         published = os.path.join(out, 'panda_published.urdf')
         shutil.copyfile(panda_path(), published)
         duration = period * periods + 0.5
         traj = os.path.join(out, 'excitation.json')
         steps.begin('excite', '[1/6] newton-euler excite; the nodes of the '
                     'first run start meanwhile')
-        live.append(NewtonEuler(
-            'excite', published, '--base', BASE, '--tip', TIP, '-o', traj,
-            '--period', period, '--harmonics', harmonics, '--seconds',
-            period * periods, '--budget', budget, '--start', *START,
-            log=os.path.join(out, 'excite.txt')))
         nominal = quiet_load(published)
         with open(published, encoding='utf-8') as f:
             text = f.read()
@@ -632,10 +647,23 @@ def main(argv=None):
         first = LoopRun('published', scene, next(domains), log_dir,
                         urdf=published)
         live.append(first)
-        live[0].result()
+        newton_euler('excite', published, '--base', BASE, '--tip', TIP, '-o',
+                     traj, '--period', period, '--harmonics', harmonics,
+                     '--seconds', period * periods, '--budget', budget,
+                     '--start', *START, log=os.path.join(out, 'excite.txt'))
         steps.end()
         segment = load_segment(traj)
-        runs, truth = {}, {}
+        # the plant's torque along the plan; computed now, it also puts the
+        # batch kernel the node fills the plan with in numba's cache
+        bare = true_torques(truth_model, segment)
+        held = true_torques(truth_model, segment, PAYLOAD)
+        published_key = 'published URDF'
+        identified_key = 'identified URDF + drive compensation'
+        untold = f'{PAYLOAD["mass"]:g} kg payload, node not told'
+        told = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
+        truth = {published_key: bare, identified_key: bare, untold: held,
+                 told: held}
+        runs = {}
         steps.begin('published', '[2/6] run with the published URDF, '
                     'recording /joint_states')
         wait_until([first], first.ready, 'the nodes of the first run')
@@ -649,15 +677,17 @@ def main(argv=None):
         live += [second, third]
         drive([first], duration)
         bag1 = os.path.join(out, 'recording')
-        runs['published URDF'] = first.finish(duration, bag=bag1)
-        truth['published URDF'] = true_torques(truth_model, segment)
+        runs[published_key] = first.finish(duration, bag=bag1)
         steps.end()
         identified = os.path.join(out, 'panda_identified.urdf')
-        steps.begin('identify', '[3/6] newton-euler identify')
-        live.append(NewtonEuler(
-            'identify', published, bag1, '--base', BASE, '--tip', TIP, '-o',
-            identified, log=os.path.join(out, 'identify.txt')))
-        live[-1].result()
+        steps.begin('identify', '[3/6] newton-euler identify; the nodes of '
+                    'the last run start meanwhile')
+        last = LoopRun('payload_told', scene, next(domains), log_dir,
+                       compensate=True, plant_payload=PAYLOAD)
+        live.append(last)
+        newton_euler('identify', published, bag1, '--base', BASE, '--tip',
+                     TIP, '-o', identified,
+                     log=os.path.join(out, 'identify.txt'))
         with open(identified, encoding='utf-8') as f:
             identified_text = f.read()
         steps.end()
@@ -665,7 +695,7 @@ def main(argv=None):
                     'node given the identified URDF (robot_description) + '
                     f'drive compensation: as is, and with {PAYLOAD["mass"]:g}'
                     ' kg picked up (node not told), recorded')
-        for r in (second, third):
+        for r in (second, third, last):
             r.describe(identified_text)
         wait_until([second, third], lambda: second.ready() and third.ready(),
                    'the nodes of the second and third runs')
@@ -674,44 +704,34 @@ def main(argv=None):
         wait_until([second, third],
                    lambda: all([second.begun(), third.begun()]),
                    'the simulation start')
-        last = LoopRun('payload_told', scene, next(domains), log_dir,
-                       compensate=True, plant_payload=PAYLOAD)
-        live.append(last)
-        last.describe(identified_text)
         drive([second, third], duration)
         bag2 = os.path.join(out, 'payload_recording')
-        runs['identified URDF + drive compensation'] = second.finish(duration)
-        truth['identified URDF + drive compensation'] = \
-            truth['published URDF']
-        untold = f'{PAYLOAD["mass"]:g} kg payload, node not told'
+        runs[identified_key] = second.finish(duration)
         runs[untold] = third.finish(duration, bag=bag2)
-        truth[untold] = true_torques(truth_model, segment, PAYLOAD)
         steps.end()
         steps.begin('payload', '[5/6] newton-euler payload --json')
-        live.append(NewtonEuler(
+        estimate = json.loads(newton_euler(
             'payload', identified, bag2, '--base', BASE, '--tip', TIP,
             '--json', log=os.path.join(out, 'payload.json')))
-        estimate = json.loads(live[-1].result())
         steps.end()
         steps.begin('estimate applied', '[6/6] the estimate set on the node '
                     '(set_parameters_atomically), run again')
         wait_until([last], last.ready, 'the nodes of the last run')
         last.rec.set_payload(estimate)
         last.go(segment)
+        prepare_plots()         # while the last run runs
         drive([last], duration)
-        told = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
         runs[told] = last.finish(duration)
-        truth[told] = truth[untold]
+        steps.end()
+        plot(runs, segment, truth, out)
         for r in (first, second, third, last):
             r.close()
-        steps.end()
     except DemoError as exc:
         print(f'demo_identify: {exc}', file=sys.stderr)
         return 1
     finally:
         for item in reversed(live):
             item.abort()
-    plot(runs, segment, truth, out)
     rows = []
     figures = {}
     for label, r in runs.items():
@@ -746,10 +766,12 @@ def main(argv=None):
         f'`~/trajectory_out`) into the simulator (PD + the efforts, as '
         f'joint_trajectory_controller); `/joint_states` is recorded to a '
         f'rosbag2; `newton-euler identify` corrects the URDF; the same '
-        f'trajectory runs with the identified URDF and '
-        f'`drives.compensate:=true`; then the plant picks up '
-        f'{PAYLOAD["mass"]:g} kg, `newton-euler payload` estimates it from '
-        f'a recording, and the estimate goes to the `payload.*` of the node.',
+        f'trajectory runs with the identified URDF (on `robot_description`)'
+        f' and `drives.compensate:=true`, and at the same time, in another '
+        f'ROS domain, with the plant holding {PAYLOAD["mass"]:g} kg the node '
+        f'is not told of; `newton-euler payload` estimates the payload from '
+        f'that recording, and a last run has the estimate in the node\'s '
+        f'`payload.*` (one `set_parameters_atomically` call).',
         '',
         '| run | feedforward torque error, RMS (N m) | relative to the true '
         'torque | tracking error, RMS (mrad) | max (mrad) |',
@@ -766,6 +788,9 @@ def main(argv=None):
         f'- payload estimate: {m:.3f} kg (true {PAYLOAD["mass"]:g}), com '
         f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm (true '
         f'[{", ".join(f"{1000 * v:.1f}" for v in PAYLOAD["com"])}])',
+        '- wall time per step (s; the nodes of a run start while an earlier '
+        'step works): ' + ', '.join(f'{k} {v:.1f}'
+                                    for k, v in steps.times.items()),
         '',
         'Files: `excitation.json`, `recording/` and `payload_recording/` '
         '(rosbag2), `panda_identified.urdf`, the output of the commands '
@@ -780,7 +805,9 @@ def main(argv=None):
     with open(os.path.join(out, 'summary.json'), 'w', encoding='utf-8') as f:
         json.dump({'runs': figures, 'payload_estimate': estimate,
                    'payload_true': PAYLOAD, 'wall_s': wall,
-                   'steps_s': steps.times}, f, indent=1)
+                   'steps_s': steps.times,
+                   'runs_timing_s': {r.label: r.timing(started) for r in (
+                       first, second, third, last)}}, f, indent=1)
     print('\n'.join(lines[4:6 + len(rows)]))
     print(f'wrote {out} ({wall:.0f} s)', flush=True)
     return 0
