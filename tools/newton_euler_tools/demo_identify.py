@@ -63,7 +63,6 @@ import io
 import json
 import os
 import shutil
-import subprocess
 import sys
 import threading
 import time
@@ -770,7 +769,7 @@ def main(argv=None):
         f' and `drives.compensate:=true`, and at the same time, in another '
         f'ROS domain, with the plant holding {PAYLOAD["mass"]:g} kg the node '
         f'is not told of; `newton-euler payload` estimates the payload from '
-        f'that recording, and a last run has the estimate in the node\'s '
+        "that recording, and a last run has the estimate in the node's "
         f'`payload.*` (one `set_parameters_atomically` call).',
         '',
         '| run | feedforward torque error, RMS (N m) | relative to the true '
