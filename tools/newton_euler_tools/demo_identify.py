@@ -92,7 +92,7 @@ RATE = 250.0
 START = [0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]
 # excitation: period (s), periods, harmonics, optimisation budget (s)
 FULL = (8.0, 1, 4, 5.0)
-QUICK = (5.0, 1, 3, 4.0)
+QUICK = (4.0, 1, 3, 2.0)
 
 
 def keep_bytecode(out):
@@ -265,9 +265,10 @@ class LoopRecorder(Recorder):
         self.names = None
         self.model_loaded = False
         self._diagnostic_ok = DiagnosticStatus.OK
-        self.node.create_subscription(JointTrajectory,
-                                      f'{SIM}/joint_trajectory',
-                                      self.filled.append, 10)
+        # (wall-clock arrival, message) of what the node passed on
+        self.node.create_subscription(
+            JointTrajectory, f'{SIM}/joint_trajectory',
+            lambda msg: self.filled.append((time.time(), msg)), 10)
         self.plan = self.node.create_publisher(JointTrajectory,
                                                f'{ID}/trajectory_in', 10)
         latched = QoSProfile(depth=1,
@@ -364,8 +365,10 @@ class LoopRun:
     URDF as ``robot_file`` or, when ``urdf`` is None, later on
     ``robot_description`` (:meth:`describe`).  :meth:`go` lets the
     simulator start; the plan is sent, stamped at its t = 0, as soon as
-    it announces it.  :meth:`finish` returns the recorded arrays and
-    stops the processes in a thread; :meth:`close` waits for them.
+    it announces it (half a second ahead; the simulator then holds t = 0
+    for up to a second until the plan comes).  :meth:`finish` returns the
+    recorded arrays and stops the processes in a thread; :meth:`close`
+    waits for them.
     """
 
     def __init__(self, label, scene, domain, log_dir, urdf=None,
@@ -452,6 +455,9 @@ class LoopRun:
         if not rec.filled:
             raise DemoError(f'[{self.label}] the simulator did not get the '
                             f'trajectory with efforts')
+        arrival, plan = rec.filled[0]
+        # > 0: the simulator held t = 0 that long for the plan
+        self.times['plan late'] = arrival - rec.t0
         states = list(rec.states)
         ns = np.array(rec.stamps_ns[:len(states)], dtype=np.int64)
         t = np.array([s[0] for s in states]) - rec.t0
@@ -468,11 +474,12 @@ class LoopRun:
             write_joint_states(bag, ns[idx], rec.names, q, qd, effort)
         self.times['recorded'] = time.monotonic()
         return {'t': t[idx], 'q': q, 'qd': qd, 'effort': effort,
-                'ff': np.array([p.effort for p in rec.filled[0].points])}
+                'ff': np.array([p.effort for p in plan.points])}
 
     def timing(self, started):
         """Return the wall time (s since ``started``) of each phase."""
-        return {k: round(v - started, 2) for k, v in self.times.items()}
+        return {k: round(v - (0.0 if k == 'plan late' else started), 2)
+                for k, v in self.times.items()}
 
     def stop(self):
         """Stop the processes, last started first, in a thread."""
@@ -718,6 +725,7 @@ def main(argv=None):
         wait_until([last], last.ready, 'the nodes of the last run')
         last.rec.set_payload(estimate)
         last.go(segment)
+        wait_until([last], last.begun, 'the simulation start')
         prepare_plots()         # while the last run runs
         drive([last], duration)
         runs[told] = last.finish(duration)
