@@ -118,6 +118,20 @@ def keep_bytecode(out):
     sys.dont_write_bytecode = False
 
 
+def warm_excite(model):
+    """
+    Load (or, the first time, compile) what ``excite`` evaluates.
+
+    Its time budget counts from its start: with numba's cache still
+    empty, compiling the regressor would take all of it, and the
+    trajectory would be the unoptimised series.
+    """
+    import scipy.optimize  # noqa: F401
+    from newton_euler_ros.core.regressor import regressor_batch
+    from newton_euler_ros.ident.base import random_states
+    regressor_batch(model, *random_states(model, 2), drives=True)
+
+
 class Steps:
     """The wall time of each step of the demo, printed as it goes."""
 
@@ -347,9 +361,13 @@ class LoopRecorder(Recorder):
                 or not future.result().result.successful:
             raise DemoError(f'{ID}: setting the payload failed')
 
-    def close(self):
+    def pause(self):
+        """Stop spinning: nothing is recorded any more."""
         self._done.set()
         self._thread.join()
+
+    def close(self):
+        self.pause()
         super().close()
 
 
@@ -451,6 +469,7 @@ class LoopRun:
         """Stop the processes (in a thread); return the recorded arrays."""
         rec = self.rec
         self.stop()
+        rec.pause()
         self.times['finish'] = time.monotonic()
         if not rec.filled:
             raise DemoError(f'[{self.label}] the simulator did not get the '
@@ -459,7 +478,7 @@ class LoopRun:
         # > 0: the simulator held t = 0 that long for the plan
         self.times['plan late'] = arrival - rec.t0
         states = list(rec.states)
-        ns = np.array(rec.stamps_ns[:len(states)], dtype=np.int64)
+        ns = np.array(rec.stamps_ns, dtype=np.int64)
         t = np.array([s[0] for s in states]) - rec.t0
         keep = (t >= -1e-9) & (t <= duration + 1e-9)
         order = np.argsort(t[keep], kind='stable')
@@ -653,6 +672,7 @@ def main(argv=None):
         first = LoopRun('published', scene, next(domains), log_dir,
                         urdf=published)
         live.append(first)
+        warm_excite(nominal)
         newton_euler('excite', published, '--base', BASE, '--tip', TIP, '-o',
                      traj, '--period', period, '--harmonics', harmonics,
                      '--seconds', period * periods, '--budget', budget,
