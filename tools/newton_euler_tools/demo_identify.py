@@ -99,12 +99,12 @@ def keep_bytecode(out):
     """
     Keep the bytecode this process and its children compile, in a cache.
 
-    Each node and command of the demo imports numba, scipy and rclpy
-    (some 1500 modules).  With PYTHONDONTWRITEBYTECODE set (and no
-    PYTHONPYCACHEPREFIX), each of the demo's 11 processes would compile
-    them from source again: 1.5 to 8 s apiece on a 2-core machine.  The
-    bytecode then goes to ``pycache`` beside NUMBA_CACHE_DIR (else beside
-    ``out``), never next to the sources.
+    The demo and each of its 8 nodes import numba, scipy and rclpy (some
+    1500 modules).  With PYTHONDONTWRITEBYTECODE set (and no
+    PYTHONPYCACHEPREFIX), every process would compile them from source
+    again, 1.5 to 2 s of CPU apiece (twice that for the commands' scipy
+    parts).  The bytecode then goes to ``pycache`` beside NUMBA_CACHE_DIR
+    (else beside ``out``), never next to the sources.
     """
     if not os.environ.get('PYTHONDONTWRITEBYTECODE') or \
             os.environ.get('PYTHONPYCACHEPREFIX'):
