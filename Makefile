@@ -4,7 +4,8 @@
 #                and tools/test (pytest.ini)
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
-#   make demo-identify  excite, record, identify, payload; out/demo_identify/
+#   make demo-identify  excite, record, identify, payload (about a minute);
+#                out/demo_identify/
 #   make bench   run the benchmarks (peers side by side; cost per effect;
 #                regressor, observer, identification time and memory)
 #   make bench-identify  identification time and memory (1 and 30 min bags)

@@ -105,7 +105,8 @@ class Recorder:
     commands.
     """
 
-    def __init__(self, domain, states_after_commands=False):
+    def __init__(self, domain, states_after_commands=False,
+                 name='demo_recorder'):
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import (DurabilityPolicy, QoSProfile,
@@ -115,7 +116,7 @@ class Recorder:
         self.rclpy = rclpy
         self.context = rclpy.Context()
         rclpy.init(context=self.context, domain_id=domain)
-        self.node = rclpy.create_node('demo_recorder', context=self.context)
+        self.node = rclpy.create_node(name, context=self.context)
         self.executor = SingleThreadedExecutor(context=self.context)
         self.executor.add_node(self.node)
         self.t0 = None

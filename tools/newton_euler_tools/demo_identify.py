@@ -25,34 +25,46 @@ centres of mass +-15 mm, inertias +-25 %: ``ident_example.perturb_urdf``),
 with joint friction (viscous + Coulomb) and rotor inertia the URDF does
 not have.  inverse_dynamics_node is given the published URDF.
 
-1. ``newton-euler excite`` writes an excitation trajectory.
+1. ``newton-euler excite`` writes an excitation trajectory (one period
+   of 8 s, 4 harmonics, 5 s of optimisation; ``--quick``: 5 s, 3, 4 s).
 2. It runs through the node (``~/trajectory_in`` -> ``~/trajectory_out``,
    efforts filled) into the simulator's ``~/joint_trajectory`` (PD + the
    points' effort, as joint_trajectory_controller); ``/joint_states`` is
    recorded by a subscriber and written to a rosbag2 (MCAP) with
    ``ident.bag``'s writer.
 3. ``newton-euler identify`` writes the corrected URDF.
-4. The same trajectory runs again, the node on the identified URDF with
-   ``drives.compensate:=true``.
-5. The plant picks up a payload (its ``payload.*`` parameters); a run
-   with the node not told is recorded, ``newton-euler payload --json``
-   estimates the payload from it, and a last run gives the estimate to
-   the node (its ``payload.*`` parameters).
+4. Two runs at once, each node given the identified URDF on
+   ``robot_description`` with ``drives.compensate:=true``: the same
+   trajectory as is, and with the plant holding a payload (its
+   ``payload.*`` parameters) the node is not told of, recorded.
+5. ``newton-euler payload --json`` estimates the payload from that
+   recording.
+6. A last run: the estimate goes to the node's ``payload.*`` in one
+   ``set_parameters_atomically`` call, and the trajectory runs again.
 
 Every run is a fresh pair of processes in a ROS domain of its own
-(``ROS_DOMAIN_ID`` from the environment as the first, if set), discovery
-limited to this host.  Writes ``summary.md`` (one table: feedforward
-torque error against the plant's true torque along the plan, and the
-tracking error, per run), ``tracking.png``, ``torques.png``, the files of
-every step (URDFs, trajectory, bags, the commands' output) and the nodes'
-logs to DIR (default out/demo_identify).
+(``ROS_DOMAIN_ID`` and the next three ids if it is set, else from
+1 + pid % 100), discovery limited to this host.  A run's processes start
+while an earlier step works (the first run's during ``excite``, the
+next two during the first run, the last during ``identify``); the
+simulator starts its clock only when the demo subscribes to its
+``/joint_states``, once the node has its model.  The commands run
+in this process through the console script's entry point, their output
+saved.  Writes ``summary.md`` (one table: feedforward torque error
+against the plant's true torque along the plan, and the tracking error,
+per run), ``summary.json`` (the figures and the wall time of each step),
+``tracking.png``, ``torques.png``, the files of every step (URDFs,
+trajectory, bags, the commands' output) and the nodes' logs to DIR
+(default out/demo_identify).
 """
 import argparse
+import contextlib
+import io
 import json
 import os
 import shutil
-import subprocess
 import sys
+import threading
 import time
 import warnings
 import xml.etree.ElementTree as ET
@@ -61,7 +73,7 @@ from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
 from .demo import (base_domain, check_exits, Child, DemoError, Recorder,
-                   stop_children, wait_for)
+                   STARTUP_TIMEOUT)
 from .demo_pick import trajectory_message
 from .ident_example import BASE, panda_path, perturb_urdf, TIP
 
@@ -78,20 +90,93 @@ KP = [300.0, 300.0, 250.0, 250.0, 60.0, 60.0, 20.0]
 KD = [30.0, 30.0, 25.0, 25.0, 6.0, 6.0, 2.0]
 RATE = 250.0
 START = [0.0, -0.3, 0.0, -2.0, 0.0, 1.8, 0.8]
+# excitation: period (s), periods, harmonics, optimisation budget (s)
+FULL = (8.0, 1, 4, 5.0)
+QUICK = (4.0, 1, 3, 2.0)
 
 
-def newton_euler(*args, log=None):
-    """Run ``newton-euler ARGS``; return its stdout (fail on error)."""
-    cmd = [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-    if log is not None:
-        with open(log, 'w', encoding='utf-8') as f:
-            f.write('$ newton-euler ' + ' '.join(map(str, args)) + '\n')
-            f.write(proc.stdout + proc.stderr)
-    if proc.returncode != 0:
+def keep_bytecode(out):
+    """
+    Keep the bytecode this process and its children compile, in a cache.
+
+    The demo and each of its 8 nodes import numba, scipy and rclpy (some
+    1500 modules).  With PYTHONDONTWRITEBYTECODE set (and no
+    PYTHONPYCACHEPREFIX), every process would compile them from source
+    again, 1.5 to 2 s of CPU apiece (twice that for the commands' scipy
+    parts).  The bytecode then goes to ``pycache`` beside NUMBA_CACHE_DIR
+    (else beside ``out``), never next to the sources.
+    """
+    if not os.environ.get('PYTHONDONTWRITEBYTECODE') or \
+            os.environ.get('PYTHONPYCACHEPREFIX'):
+        return
+    beside = os.environ.get('NUMBA_CACHE_DIR') or out
+    prefix = os.path.join(os.path.dirname(os.path.abspath(beside)),
+                          'pycache')
+    os.environ['PYTHONPYCACHEPREFIX'] = prefix
+    del os.environ['PYTHONDONTWRITEBYTECODE']
+    sys.pycache_prefix = prefix
+    sys.dont_write_bytecode = False
+
+
+def warm_excite(model):
+    """
+    Load (or, the first time, compile) what ``excite`` evaluates.
+
+    Its time budget counts from its start: with numba's cache still
+    empty, compiling the regressor would take all of it, and the
+    trajectory would be the unoptimised series.
+    """
+    import scipy.optimize  # noqa: F401
+    from newton_euler_ros.core.regressor import regressor_batch
+    from newton_euler_ros.ident.base import random_states
+    regressor_batch(model, *random_states(model, 2), drives=True)
+
+
+class Steps:
+    """The wall time of each step of the demo, printed as it goes."""
+
+    def __init__(self, started):
+        self.started = started
+        self.times = {}
+        self._step = None
+
+    def begin(self, key, text):
+        """Start step ``key``, printing ``text`` and the time so far."""
+        self._step = (key, time.monotonic())
+        print(f'{text} (at {time.monotonic() - self.started:.1f} s)',
+              flush=True)
+
+    def end(self):
+        """End the current step."""
+        key, begun = self._step
+        self.times[key] = round(time.monotonic() - begun, 2)
+
+
+def newton_euler(*args, log):
+    """
+    Run ``newton-euler ARGS``; write its output to ``log``, return stdout.
+
+    The console script's entry point (``newton_euler_ros.cli.main``) runs
+    in this process, which has imported numba, scipy and the kernels
+    already: a process of its own would spend 2 to 4 s starting up.
+    DemoError when it fails.
+    """
+    from newton_euler_ros import cli
+    args = [str(a) for a in args]
+    out, err = io.StringIO(), io.StringIO()
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            code = cli.main(args)
+    except SystemExit as exc:       # argparse on bad arguments
+        code = exc.code
+    stdout, stderr = out.getvalue(), err.getvalue()
+    with open(log, 'w', encoding='utf-8') as f:
+        f.write('$ newton-euler ' + ' '.join(args) + '\n')
+        f.write(stdout + stderr)
+    if code != 0:
         raise DemoError(f'newton-euler {args[0]} failed: '
-                        f'{proc.stderr.strip()[-400:]}')
-    return proc.stdout
+                        f'{stderr.strip()[-400:]}')
+    return stdout
 
 
 def real_plant_urdf(text, links, seed):
@@ -169,19 +254,66 @@ def write_scene(path, robot_file, duration):
 
 
 class LoopRecorder(Recorder):
-    """The demo recorder, plus the filled trajectory and ns stamps."""
+    """
+    The recorder of one run, spinning in a thread of its own.
 
-    def __init__(self, domain):
-        super().__init__(domain)
+    Besides joint states and the start time it sees the trajectory the
+    node filled, publishes the plan on the node's ``~/trajectory_in`` and
+    a URDF on ``robot_description``, watches the node's diagnostics (is
+    its model loaded?) and sets its ``payload.*`` parameters.
+    ``/joint_states`` is subscribed only on :meth:`open`: the simulator
+    starts its clock once it has its two subscribers (the node and this
+    recorder), so a run's processes can start well before it goes.
+    """
+
+    def __init__(self, domain, name):
+        self.opened = False
+        super().__init__(domain, name=name)
+        from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+        from rclpy.qos import (DurabilityPolicy, QoSProfile,
+                               ReliabilityPolicy)
+        from std_msgs.msg import String
         from trajectory_msgs.msg import JointTrajectory
         self.filled = []
         self.stamps_ns = []
         self.names = None
-        self.node.create_subscription(JointTrajectory,
-                                      f'{SIM}/joint_trajectory',
-                                      self.filled.append, 10)
+        self.model_loaded = False
+        self._diagnostic_ok = DiagnosticStatus.OK
+        # (wall-clock arrival, message) of what the node passed on
+        self.node.create_subscription(
+            JointTrajectory, f'{SIM}/joint_trajectory',
+            lambda msg: self.filled.append((time.time(), msg)), 10)
         self.plan = self.node.create_publisher(JointTrajectory,
                                                f'{ID}/trajectory_in', 10)
+        latched = QoSProfile(depth=1,
+                             reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+        self._string = String
+        self.description = self.node.create_publisher(
+            String, 'robot_description', latched)
+        self.node.create_subscription(DiagnosticArray, '/diagnostics',
+                                      self._on_diagnostics, 10)
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._spin, daemon=True)
+        self._thread.start()
+
+    def _spin(self):
+        while not self._done.is_set():
+            try:
+                self.executor.spin_once(timeout_sec=0.05)
+            except Exception:       # the context shut down under us
+                if not self._done.is_set():
+                    raise
+
+    def _subscribe_states(self):
+        if self.opened and self.state_sub is None:
+            self.state_sub = self.node.create_subscription(
+                self._state_type, '/joint_states', self._on_state, 1000)
+
+    def open_states(self):
+        """Subscribe to /joint_states: the simulator may start."""
+        self.opened = True
+        self._subscribe_states()
 
     def _on_state(self, msg):
         super()._on_state(msg)
@@ -190,88 +322,230 @@ class LoopRecorder(Recorder):
         if self.names is None:
             self.names = list(msg.name)
 
+    def _on_diagnostics(self, msg):
+        ok = self._diagnostic_ok
+        for status in msg.status:
+            # the node's first status is OK once it has a model
+            if status.name == ID and status.level == ok:
+                self.model_loaded = True
+
+    def describe(self, text):
+        """Publish ``text`` on robot_description (latched)."""
+        self.description.publish(self._string(data=text))
+
+    def set_payload(self, estimate):
+        """Set the node's payload.* in one set_parameters_atomically call."""
+        from rcl_interfaces.srv import SetParametersAtomically
+        from rclpy.parameter import Parameter
+        client = self.node.create_client(
+            SetParametersAtomically, f'{ID}/set_parameters_atomically')
+        request = SetParametersAtomically.Request(parameters=[
+            Parameter(k, value=v).to_parameter_msg()
+            for k, v in estimate.items()])
+        end = time.monotonic() + 30.0
+        future = None
+        while time.monotonic() < end:
+            if not client.service_is_ready():
+                time.sleep(0.02)
+                continue
+            # a fresh client's first response can be lost in discovery
+            # (ros2/rmw_fastrtps#418); setting the same values is idempotent
+            future = client.call_async(request)
+            resend = min(end, time.monotonic() + 2.0)
+            while not future.done() and time.monotonic() < resend:
+                time.sleep(0.01)
+            if future.done():
+                break
+            client.remove_pending_request(future)
+        if future is None or not future.done() \
+                or not future.result().result.successful:
+            raise DemoError(f'{ID}: setting the payload failed')
+
+    def pause(self):
+        """Stop spinning: nothing is recorded any more."""
+        self._done.set()
+        self._thread.join()
+
+    def close(self):
+        self.pause()
+        super().close()
+
 
 def _array(values):
     return '[' + ','.join(repr(float(v)) for v in values) + ']'
 
 
-def run(label, scene_path, node_urdf, segment, duration, domain, log_dir,
-        compensate=False, plant_payload=None, node_payload=None, bag=None):
-    """Run simulator + node once; return the recorded arrays."""
-    children = []
-    rec = LoopRecorder(domain)
-    status = {}
-    sim_args = ['-p', f'scene:={scene_path}', '-p', 'wait_for_subscribers:=2']
-    if plant_payload:
-        sim_args += ['-p', f'payload.mass:={plant_payload["mass"]}',
-                     '-p', f'payload.com:={_array(plant_payload["com"])}',
-                     '-p',
-                     f'payload.inertia:={_array(plant_payload["inertia"])}']
-    id_args = ['-p', f'robot_file:={node_urdf}', '-p',
-               f'base_link:={BASE}', '-p', f'tip_link:={TIP}',
-               '-p', 'mode:=gravity',
-               '-p', f'drives.compensate:={"true" if compensate else "false"}',
-               '-r', f'~/trajectory_out:={SIM}/joint_trajectory']
-    if node_payload:
-        id_args += ['-p', f'payload.mass:={node_payload["payload.mass"]}',
-                    '-p',
-                    f'payload.com:={_array(node_payload["payload.com"])}',
-                    '-p', 'payload.inertia:='
-                    f'{_array(node_payload["payload.inertia"])}']
-    try:
-        children.append(Child(f'{label}_robot_sim_node',
-                              'newton_euler_ros.nodes.robot_sim_node',
-                              sim_args, domain, log_dir))
-        wait_for(rec, children,
-                 lambda: rec.subscribers(f'{SIM}/joint_trajectory') >= 1,
-                 'robot_sim_node')
-        children.append(Child(f'{label}_inverse_dynamics_node',
-                              'newton_euler_ros.nodes.inverse_dynamics_node',
-                              id_args, domain, log_dir))
-        wait_for(rec, children,
-                 lambda: rec.plan.get_subscription_count() >= 1
-                 and rec.publishers(f'{SIM}/joint_trajectory') >= 1
-                 and rec.t0 is not None, 'the simulation start')
-        rec.plan.publish(trajectory_message(rec_names(), rec.t0, segment))
-        wait_for(rec, children, lambda: len(rec.filled) >= 1,
-                 'the trajectory with efforts')
-        end = time.monotonic() + 60.0 + 5.0 * duration
-        while True:
-            rec.spin_once()
-            for child in children:
+class LoopRun:
+    """
+    One run: robot_sim_node and inverse_dynamics_node, a ROS domain each.
+
+    Both processes start at once, on construction; the node gets the
+    URDF as ``robot_file`` or, when ``urdf`` is None, later on
+    ``robot_description`` (:meth:`describe`).  :meth:`go` lets the
+    simulator start; the plan is sent, stamped at its t = 0, as soon as
+    it announces it (half a second ahead; the simulator then holds t = 0
+    for up to a second until the plan comes).  :meth:`finish` returns the
+    recorded arrays and stops the processes in a thread; :meth:`close`
+    waits for them.
+    """
+
+    def __init__(self, label, scene, domain, log_dir, urdf=None,
+                 compensate=False, plant_payload=None):
+        self.label = label
+        self.children = []
+        self.status = {}
+        self.segment = None
+        self.sent = False
+        self._stopper = None
+        self.closed = False
+        self.times = {'start': time.monotonic()}    # wall clock, per phase
+        self.rec = LoopRecorder(domain, f'demo_recorder_{label}')
+        sim_args = ['-p', f'scene:={scene}', '-p', 'wait_for_subscribers:=2']
+        if plant_payload:
+            sim_args += [
+                '-p', f'payload.mass:={plant_payload["mass"]}',
+                '-p', f'payload.com:={_array(plant_payload["com"])}',
+                '-p', f'payload.inertia:={_array(plant_payload["inertia"])}']
+        id_args = ['-p', f'base_link:={BASE}', '-p', f'tip_link:={TIP}',
+                   '-p', 'mode:=gravity', '-p', 'drives.compensate:='
+                   f'{"true" if compensate else "false"}',
+                   '-p', 'diagnostics_period:=0.2',
+                   '-r', f'~/trajectory_out:={SIM}/joint_trajectory']
+        if urdf:
+            id_args = ['-p', f'robot_file:={urdf}', *id_args]
+        self.children.append(Child(f'{label}_robot_sim_node',
+                                   'newton_euler_ros.nodes.robot_sim_node',
+                                   sim_args, domain, log_dir))
+        self.children.append(Child(
+            f'{label}_inverse_dynamics_node',
+            'newton_euler_ros.nodes.inverse_dynamics_node', id_args, domain,
+            log_dir))
+
+    def describe(self, text):
+        """Give the node its URDF on robot_description."""
+        self.rec.describe(text)
+
+    def check(self):
+        """Raise DemoError when a process exited before its time."""
+        if self._stopper is None:
+            for child in self.children:
                 child.check_alive()
-            t = rec.last_time()
-            if t is not None and t >= duration - 1e-9:
-                break
-            if time.monotonic() > end:
-                raise DemoError(f'[{label}] did not reach t = {duration} s')
-    finally:
-        stop_children(children, rec, status)
-    check_exits(label, status)
-    ns = np.array(rec.stamps_ns, dtype=np.int64)
-    t = np.array([s[0] for s in rec.states]) - rec.t0
-    keep = (t >= -1e-9) & (t <= duration + 1e-9)
-    order = np.argsort(t[keep], kind='stable')
-    idx = np.flatnonzero(keep)[order]
-    q = np.array([rec.states[i][1] for i in idx])
-    qd = np.array([rec.states[i][2] for i in idx])
-    effort = np.array([rec.states[i][3] for i in idx])
-    if bag is not None:
-        from newton_euler_ros.ident.bag import write_joint_states
-        if os.path.exists(bag):
-            shutil.rmtree(bag)
-        write_joint_states(bag, ns[idx], rec.names, q, qd, effort)
-    filled = rec.filled[0]
-    return {'t': t[idx], 'q': q, 'qd': qd, 'effort': effort,
-            'ff': np.array([p.effort for p in filled.points])}
+
+    def ready(self):
+        """Both nodes up and matched, the node's model loaded."""
+        self.check()
+        rec = self.rec
+        return (rec.publishers('/joint_states') >= 1
+                and rec.plan.get_subscription_count() >= 1
+                and rec.publishers(f'{SIM}/joint_trajectory') >= 1
+                and rec.model_loaded)
+
+    def go(self, segment):
+        """Let the simulator start; the plan follows its start time."""
+        self.segment = segment
+        self.times['go'] = time.monotonic()
+        self.rec.open_states()
+
+    def begun(self):
+        """Send the plan once t = 0 is known; True once it is sent."""
+        self.check()
+        rec = self.rec
+        if not self.sent and rec.t0 is not None:
+            rec.plan.publish(trajectory_message(_NAMES, rec.t0,
+                                                self.segment))
+            self.sent = True
+            self.times['plan sent'] = time.monotonic()
+        return self.sent
+
+    def done(self, duration):
+        """Return True once the simulation reached ``duration``."""
+        t = self.rec.last_time()
+        if self.begun() and t is not None and t >= duration - 1e-9:
+            self.times.setdefault('end reached', time.monotonic())
+            return True
+        return False
+
+    def finish(self, duration, bag=None):
+        """Stop the processes (in a thread); return the recorded arrays."""
+        rec = self.rec
+        self.stop()
+        rec.pause()
+        self.times['finish'] = time.monotonic()
+        if not rec.filled:
+            raise DemoError(f'[{self.label}] the simulator did not get the '
+                            f'trajectory with efforts')
+        arrival, plan = rec.filled[0]
+        # > 0: the simulator held t = 0 that long for the plan
+        self.times['plan late'] = arrival - rec.t0
+        states = list(rec.states)
+        ns = np.array(rec.stamps_ns, dtype=np.int64)
+        t = np.array([s[0] for s in states]) - rec.t0
+        keep = (t >= -1e-9) & (t <= duration + 1e-9)
+        order = np.argsort(t[keep], kind='stable')
+        idx = np.flatnonzero(keep)[order]
+        q = np.array([states[i][1] for i in idx])
+        qd = np.array([states[i][2] for i in idx])
+        effort = np.array([states[i][3] for i in idx])
+        if bag is not None:
+            from newton_euler_ros.ident.bag import write_joint_states
+            if os.path.exists(bag):
+                shutil.rmtree(bag)
+            write_joint_states(bag, ns[idx], rec.names, q, qd, effort)
+        self.times['recorded'] = time.monotonic()
+        return {'t': t[idx], 'q': q, 'qd': qd, 'effort': effort,
+                'ff': np.array([p.effort for p in plan.points])}
+
+    def timing(self, started):
+        """Return the wall time (s since ``started``) of each phase."""
+        return {k: round(v - (0.0 if k == 'plan late' else started), 2)
+                for k, v in self.times.items()}
+
+    def stop(self):
+        """Stop the processes, last started first, in a thread."""
+        if self._stopper is None:
+            def stop_all():
+                for child in reversed(self.children):
+                    self.status[child.label] = child.stop()
+            self._stopper = threading.Thread(target=stop_all, daemon=True)
+            self._stopper.start()
+
+    def close(self):
+        """Wait for the processes to exit; DemoError unless all exit 0."""
+        self.abort()
+        check_exits(self.label, self.status)
+
+    def abort(self):
+        """Stop the processes and the recorder, whatever state they are in."""
+        self.stop()
+        self._stopper.join()
+        if not self.closed:
+            self.closed = True
+            self.rec.close()
+
+
+def wait_until(runs, predicate, what, timeout=STARTUP_TIMEOUT):
+    """Poll ``predicate()``; fail if a process exits or on timeout."""
+    end = time.monotonic() + timeout
+    while not predicate():
+        for r in runs:
+            r.check()
+        if time.monotonic() > end:
+            raise DemoError(f'timed out after {timeout:.0f} s waiting for '
+                            f'{what}')
+        time.sleep(0.02)
+
+
+def drive(runs, duration):
+    """Run ``runs`` (gone already) until each reached ``duration``."""
+    def all_done():
+        done = [r.done(duration) for r in runs]     # each sends its plan
+        return all(done)
+    wait_until(runs, all_done,
+               ', '.join(r.label for r in runs) + f' to reach t = '
+               f'{duration:g} s', 60.0 + 5.0 * duration)
 
 
 _NAMES = [f'panda_joint{k}' for k in range(1, 8)]
-
-
-def rec_names():
-    """Joint names of the Panda chain."""
-    return _NAMES
 
 
 def plan_at(times, segment):
@@ -312,6 +586,13 @@ def quiet_load(path):
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
         return load_robot(path, base=BASE, tip=TIP)
+
+
+def prepare_plots():
+    """Import matplotlib (Agg), a second or two, ahead of :func:`plot`."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot  # noqa: F401
 
 
 def plot(runs, segment, truth, out):
@@ -361,11 +642,23 @@ def main(argv=None):
     out = os.path.abspath(args.out)
     log_dir = os.path.join(out, 'logs')
     os.makedirs(log_dir, exist_ok=True)
-    period, periods, harmonics, budget = ((5.0, 1, 3, 4.0) if args.quick
-                                          else (6.0, 2, 4, 10.0))
+    keep_bytecode(out)
+    period, periods, harmonics, budget = QUICK if args.quick else FULL
     try:
+        base = base_domain(4)
+    except ValueError as exc:
+        print(f'demo_identify: {exc}', file=sys.stderr)
+        return 2
+    steps = Steps(started)
+    live = []           # the runs to stop if anything fails
+    try:
+        domains = iter(range(base, base + 4))
         published = os.path.join(out, 'panda_published.urdf')
         shutil.copyfile(panda_path(), published)
+        duration = period * periods + 0.5
+        traj = os.path.join(out, 'excitation.json')
+        steps.begin('excite', '[1/6] newton-euler excite; the nodes of the '
+                    'first run start meanwhile')
         nominal = quiet_load(published)
         with open(published, encoding='utf-8') as f:
             text = f.read()
@@ -374,58 +667,98 @@ def main(argv=None):
             f.write(real_plant_urdf(text, set(nominal.info['urdf']['links']),
                                     args.seed))
         truth_model = quiet_load(real)
-        duration = period * periods + 0.5
         scene = os.path.join(out, 'panda_real.yaml')
         write_scene(scene, real, duration)
-        traj = os.path.join(out, 'excitation.json')
-        print('[1/6] newton-euler excite', flush=True)
-        newton_euler('excite', published, '--base', BASE, '--tip', TIP,
-                     '-o', traj, '--period', period, '--harmonics',
-                     harmonics, '--seconds', period * periods, '--budget',
-                     budget, '--start', *START,
-                     log=os.path.join(out, 'excite.txt'))
+        first = LoopRun('published', scene, next(domains), log_dir,
+                        urdf=published)
+        live.append(first)
+        warm_excite(nominal)
+        newton_euler('excite', published, '--base', BASE, '--tip', TIP, '-o',
+                     traj, '--period', period, '--harmonics', harmonics,
+                     '--seconds', period * periods, '--budget', budget,
+                     '--start', *START, log=os.path.join(out, 'excite.txt'))
+        steps.end()
         segment = load_segment(traj)
-        base = base_domain()
-        domains = iter(1 + (base - 1 + k) % 100 for k in range(10))
-        runs, truth = {}, {}
+        # the plant's torque along the plan; computed now, it also puts the
+        # batch kernel the node fills the plan with in numba's cache
+        bare = true_torques(truth_model, segment)
+        held = true_torques(truth_model, segment, PAYLOAD)
+        published_key = 'published URDF'
+        identified_key = 'identified URDF + drive compensation'
+        untold = f'{PAYLOAD["mass"]:g} kg payload, node not told'
+        told = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
+        truth = {published_key: bare, identified_key: bare, untold: held,
+                 told: held}
+        runs = {}
+        steps.begin('published', '[2/6] run with the published URDF, '
+                    'recording /joint_states')
+        wait_until([first], first.ready, 'the nodes of the first run')
+        first.go(segment)
+        wait_until([first], first.begun, 'the simulation start')
+        # the next two runs' nodes start now; their URDF comes later
+        second = LoopRun('identified', scene, next(domains), log_dir,
+                         compensate=True)
+        third = LoopRun('payload_untold', scene, next(domains), log_dir,
+                        compensate=True, plant_payload=PAYLOAD)
+        live += [second, third]
+        drive([first], duration)
         bag1 = os.path.join(out, 'recording')
-        print('[2/6] run with the published URDF, recording', flush=True)
-        runs['published URDF'] = run('published', scene, published, segment,
-                                     duration, next(domains), log_dir,
-                                     bag=bag1)
-        truth['published URDF'] = true_torques(truth_model, segment)
+        runs[published_key] = first.finish(duration, bag=bag1)
+        steps.end()
         identified = os.path.join(out, 'panda_identified.urdf')
-        print('[3/6] newton-euler identify', flush=True)
+        steps.begin('identify', '[3/6] newton-euler identify; the nodes of '
+                    'the last run start meanwhile')
+        last = LoopRun('payload_told', scene, next(domains), log_dir,
+                       compensate=True, plant_payload=PAYLOAD)
+        live.append(last)
         newton_euler('identify', published, bag1, '--base', BASE, '--tip',
                      TIP, '-o', identified,
                      log=os.path.join(out, 'identify.txt'))
-        print('[4/6] run with the identified URDF + drive compensation',
-              flush=True)
-        key = 'identified URDF + drive compensation'
-        runs[key] = run('identified', scene, identified, segment, duration,
-                        next(domains), log_dir, compensate=True)
-        truth[key] = truth['published URDF']
+        with open(identified, encoding='utf-8') as f:
+            identified_text = f.read()
+        steps.end()
+        steps.begin('identified + untold', '[4/6] two runs at once, the '
+                    'node given the identified URDF (robot_description) + '
+                    f'drive compensation: as is, and with {PAYLOAD["mass"]:g}'
+                    ' kg picked up (node not told), recorded')
+        for r in (second, third, last):
+            r.describe(identified_text)
+        wait_until([second, third], lambda: second.ready() and third.ready(),
+                   'the nodes of the second and third runs')
+        second.go(segment)
+        third.go(segment)
+        wait_until([second, third],
+                   lambda: all([second.begun(), third.begun()]),
+                   'the simulation start')
+        drive([second, third], duration)
         bag2 = os.path.join(out, 'payload_recording')
-        print(f'[5/6] payload {PAYLOAD["mass"]} kg picked up, node not told;'
-              f' newton-euler payload', flush=True)
-        key = f'{PAYLOAD["mass"]:g} kg payload, node not told'
-        runs[key] = run('payload_untold', scene, identified, segment,
-                        duration, next(domains), log_dir, compensate=True,
-                        plant_payload=PAYLOAD, bag=bag2)
-        truth[key] = true_torques(truth_model, segment, PAYLOAD)
+        runs[identified_key] = second.finish(duration)
+        runs[untold] = third.finish(duration, bag=bag2)
+        steps.end()
+        steps.begin('payload', '[5/6] newton-euler payload --json')
         estimate = json.loads(newton_euler(
             'payload', identified, bag2, '--base', BASE, '--tip', TIP,
             '--json', log=os.path.join(out, 'payload.json')))
-        print('[6/6] payload estimate given to the node', flush=True)
-        key = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
-        runs[key] = run('payload_told', scene, identified, segment, duration,
-                        next(domains), log_dir, compensate=True,
-                        plant_payload=PAYLOAD, node_payload=estimate)
-        truth[key] = truth[f'{PAYLOAD["mass"]:g} kg payload, node not told']
+        steps.end()
+        steps.begin('estimate applied', '[6/6] the estimate set on the node '
+                    '(set_parameters_atomically), run again')
+        wait_until([last], last.ready, 'the nodes of the last run')
+        last.rec.set_payload(estimate)
+        last.go(segment)
+        wait_until([last], last.begun, 'the simulation start')
+        prepare_plots()         # while the last run runs
+        drive([last], duration)
+        runs[told] = last.finish(duration)
+        steps.end()
+        plot(runs, segment, truth, out)
+        for r in (first, second, third, last):
+            r.close()
     except DemoError as exc:
         print(f'demo_identify: {exc}', file=sys.stderr)
         return 1
-    plot(runs, segment, truth, out)
+    finally:
+        for item in reversed(live):
+            item.abort()
     rows = []
     figures = {}
     for label, r in runs.items():
@@ -460,10 +793,12 @@ def main(argv=None):
         f'`~/trajectory_out`) into the simulator (PD + the efforts, as '
         f'joint_trajectory_controller); `/joint_states` is recorded to a '
         f'rosbag2; `newton-euler identify` corrects the URDF; the same '
-        f'trajectory runs with the identified URDF and '
-        f'`drives.compensate:=true`; then the plant picks up '
-        f'{PAYLOAD["mass"]:g} kg, `newton-euler payload` estimates it from '
-        f'a recording, and the estimate goes to the `payload.*` of the node.',
+        f'trajectory runs with the identified URDF (on `robot_description`)'
+        f' and `drives.compensate:=true`, and at the same time, in another '
+        f'ROS domain, with the plant holding {PAYLOAD["mass"]:g} kg the node '
+        f'is not told of; `newton-euler payload` estimates the payload from '
+        "that recording, and a last run has the estimate in the node's "
+        f'`payload.*` (one `set_parameters_atomically` call).',
         '',
         '| run | feedforward torque error, RMS (N m) | relative to the true '
         'torque | tracking error, RMS (mrad) | max (mrad) |',
@@ -480,6 +815,9 @@ def main(argv=None):
         f'- payload estimate: {m:.3f} kg (true {PAYLOAD["mass"]:g}), com '
         f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm (true '
         f'[{", ".join(f"{1000 * v:.1f}" for v in PAYLOAD["com"])}])',
+        '- wall time per step (s; the nodes of a run start while an earlier '
+        'step works): ' + ', '.join(f'{k} {v:.1f}'
+                                    for k, v in steps.times.items()),
         '',
         'Files: `excitation.json`, `recording/` and `payload_recording/` '
         '(rosbag2), `panda_identified.urdf`, the output of the commands '
@@ -493,7 +831,10 @@ def main(argv=None):
         f.write('\n'.join(lines))
     with open(os.path.join(out, 'summary.json'), 'w', encoding='utf-8') as f:
         json.dump({'runs': figures, 'payload_estimate': estimate,
-                   'payload_true': PAYLOAD, 'wall_s': wall}, f, indent=1)
+                   'payload_true': PAYLOAD, 'wall_s': wall,
+                   'steps_s': steps.times,
+                   'runs_timing_s': {r.label: r.timing(started) for r in (
+                       first, second, third, last)}}, f, indent=1)
     print('\n'.join(lines[4:6 + len(rows)]))
     print(f'wrote {out} ({wall:.0f} s)', flush=True)
     return 0

@@ -18,6 +18,7 @@ import os
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 pytest.importorskip('rclpy')
@@ -40,14 +41,20 @@ def test_quick_identification_loop(tmp_path):
     identified = runs['identified URDF + drive compensation']
     untold = runs['2 kg payload, node not told']
     told = runs['2 kg payload, estimate applied']
-    # the identified model's feedforward is closer to the plant's torque
-    assert identified['ff_rms'] < 0.8 * published['ff_rms']
+    # the identified model's feedforward is much closer to the plant's
+    # torque (about a tenth of the published URDF's error)
+    assert identified['ff_rms'] < 0.5 * published['ff_rms']
     # a payload the node does not know costs tracking; its estimate
     # brings the error back to the identified model's
-    assert untold['tracking_rms'] > 2 * told['tracking_rms']
-    assert told['ff_rms'] < 0.5 * untold['ff_rms']
-    est = result['payload_estimate']
-    assert est['payload.mass'] == pytest.approx(2.0, rel=0.05)
+    assert untold['tracking_rms'] > 3 * told['tracking_rms']
+    assert told['ff_rms'] < 0.25 * untold['ff_rms']
+    assert told['ff_rms'] < 1.5 * identified['ff_rms']
+    # the estimate, as the issue asks of payload: mass within 3 %,
+    # centre of mass within 15 mm
+    est, true = result['payload_estimate'], result['payload_true']
+    assert est['payload.mass'] == pytest.approx(true['mass'], rel=0.03)
+    com_error = np.linalg.norm(np.subtract(est['payload.com'], true['com']))
+    assert com_error < 0.015, com_error
     # the files of every step: a real rosbag2, URDF, trajectory, report
     for name in ('summary.md', 'tracking.png', 'torques.png',
                  'excitation.json', 'panda_identified.urdf'):
