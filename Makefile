@@ -34,6 +34,12 @@ export ROS_AUTOMATIC_DISCOVERY_RANGE := LOCALHOST
 # cache where the package keeps it anyway, in the user's cache: a fresh
 # clone of the same sources compiles nothing (core/kernels/_jit.py).
 export ROS_LOG_DIR := $(CURDIR)/build/ros_log
+# Python's bytecode goes to build/pycache, never beside the sources, and is
+# written even where PYTHONDONTWRITEBYTECODE is set: without it every
+# process (make test starts hundreds: nodes, CLI commands, demos) compiles
+# numba, scipy and rclpy from source again, about 1.5 s of CPU each.
+unexport PYTHONDONTWRITEBYTECODE
+export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 export NUMBA_CACHE_DIR ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/newton_euler_ros/numba
 
 .PHONY: setup test demo demo-pick demo-identify bench bench-identify latency \
