@@ -72,7 +72,7 @@ from .entry import (run_coriolis_matrix, run_coriolis_matrix_batch,
                     run_inverse_dynamics, run_inverse_dynamics_batch,
                     run_jacobian, run_link_poses, run_mass_matrix,
                     run_mass_matrix_batch, run_mass_matrix_crba,
-                    run_regressor_batch)
+                    run_momentum_terms, run_regressor_batch)
 from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
@@ -84,7 +84,7 @@ from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      W_WIDTH, WRENCH_BASE, WRENCH_EE, WRENCH_NONE,
                      WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
-                           recursion, unit_columns)
+                           momentum_terms, recursion, unit_columns)
 from .status import check_finite, first_nonfinite, round_into
 
 __all__ = [
@@ -97,13 +97,13 @@ __all__ = [
     'first_nonfinite', 'flags', 'forward_kinematics', 'GRAVITY',
     'jacobian', 'joint_trig', 'L_BODY', 'L_COM', 'L_INERTIA', 'L_MASS',
     'L_P', 'L_R', 'L_TYPE', 'L_WIDTH', 'mass_matrix_columns',
-    'mass_matrix_crba', 'NONFINITE', 'OVERFLOW', 'pack', 'recursion',
+    'mass_matrix_crba', 'momentum_terms', 'NONFINITE', 'OVERFLOW', 'pack', 'recursion',
     'round_into', 'run_coriolis_matrix', 'run_coriolis_matrix_batch',
     'run_forward_dynamics', 'run_forward_dynamics_batch',
     'run_gravity_torques', 'run_gravity_torques_batch',
     'run_inverse_dynamics', 'run_inverse_dynamics_batch', 'run_jacobian',
     'run_link_poses', 'run_mass_matrix', 'run_mass_matrix_batch',
-    'run_mass_matrix_crba', 'run_regressor_batch', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
+    'run_mass_matrix_crba', 'run_momentum_terms', 'run_regressor_batch', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
     'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
     'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',
 ]

@@ -39,7 +39,7 @@ from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, OVERFLOW, SINGULAR,
                      SIZE, VELOCITY, W_WIDTH, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
-                           mass_matrix_columns, recursion)
+                           mass_matrix_columns, momentum_terms, recursion)
 from .regressor import drive_columns, regressor_columns
 from .status import check_finite, first_bad_row, first_nonfinite, matrix_status
 
@@ -218,6 +218,24 @@ def run_coriolis_matrix_batch(P, Q, QD, ws, cw, CC, status):
             status[0] = code
             return k
     return -1
+
+
+@njit(**ENTRY)
+def run_momentum_terms(P, q, qd, ws, cw, out):
+    """D qd, C^T qd and g into the rows of ``out`` (3, n), one recursion."""
+    links, frames = _split(P)
+    n = links.shape[0]
+    bad = _sizes(n, q, qd, q, frames[0, :6], ws, W_WIDTH)
+    if bad >= 0:
+        return bad
+    if out.shape[0] != 3 or out.shape[1] != n:
+        return SIZE + 4
+    if cw.shape[0] < n + 1 or cw.shape[1] != CW_WIDTH:
+        return SIZE + 5
+    bad = check_finite(q, qd, q, frames[0, :6])
+    if bad >= 0:
+        return bad
+    return momentum_terms(links, frames, q, qd, ws, cw, out)
 
 
 @njit(**ENTRY)
