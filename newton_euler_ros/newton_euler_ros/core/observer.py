@@ -101,15 +101,13 @@ _BAD_TORQUE = 2 * NONFINITE
 @njit(**ENTRY)
 def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
     """
-    One sample, one compiled call: the model terms, then S and r.
+    One sample in one call: D qd, C^T qd, g (one recursion), then S, r.
 
-    D qd, C^T qd and g come from one recursion (``run_momentum_terms``,
-    which checks q, qd and the workspaces); then p = D qd + armature qd
-    and beta = tau - lost + C^T qd - g.  If one is not finite the state
-    is left untouched and ``_BAD_TORQUE`` + the joint returned (a kernel
-    status code for q or qd).  Otherwise S and r advance over ``dt``
-    (``dt <= 0``: S starts at this sample, keeping r) and -1 is returned
-    (-2 if r came out non-finite and was reset to 0).
+    p = D qd + armature qd and beta = tau - lost + C^T qd - g; if one is
+    not finite the state is left untouched and ``_BAD_TORQUE`` + the
+    joint returned (a kernel status code for bad q or qd).  Else S and r
+    advance over ``dt`` (``dt <= 0``: S restarts here, keeping r) and -1
+    is returned (-2 if r came out non-finite and was reset to 0).
     """
     code = run_momentum_terms(P, q, qd, ws, cw, buf[:3])
     if code >= 0:
@@ -295,7 +293,9 @@ class MomentumObserver:
         # the compiled step's buffer: the model terms, p and beta of the
         # last sample, the armature and the gain (rows _DQD ... _GAIN)
         self._buf = np.zeros((_ROWS, n))
-        self.gain = gain
+        # gain and armature: views of rows of it (change them in place)
+        self.gain = self._buf[_GAIN]
+        self.gain[:] = _per_joint('gain', gain, n)
         self.max_gap = float(max_gap)
         if not (math.isfinite(self.max_gap) and self.max_gap > 0.0):
             raise ValueError(f'max_gap: must be finite and > 0, got '
@@ -304,7 +304,9 @@ class MomentumObserver:
             raise ValueError('drive_torque: must be callable '
                              '(qd, qdd_or_None) -> torque')
         self.drive_torque = drive_torque
-        self.armature = armature
+        self.armature = self._buf[_ARMATURE]
+        if armature is not None:
+            self.armature[:] = _per_joint('armature', armature, n, False)
         self.damping = float(damping)
         if not (math.isfinite(self.damping) and self.damping >= 0.0):
             raise ValueError(f'damping: must be finite and >= 0, got '
@@ -321,25 +323,6 @@ class MomentumObserver:
         self._A = np.zeros((min(n, 6), min(n, 6)))
         self._y = np.zeros(min(n, 6))
         self._packed = model.packed
-
-    @property
-    def gain(self):
-        """K in 1/s, one per joint (set with one value or one per joint)."""
-        return self._buf[_GAIN]
-
-    @gain.setter
-    def gain(self, value):
-        self._buf[_GAIN] = _per_joint('gain', value, self.n)
-
-    @property
-    def armature(self):
-        """Rotor inertia per joint, added to the diagonal of D in p."""
-        return self._buf[_ARMATURE]
-
-    @armature.setter
-    def armature(self, value):
-        self._buf[_ARMATURE] = (0.0 if value is None else _per_joint(
-            'armature', value, self.n, positive=False))
 
     def warm_up(self):
         """Compile (or load) every kernel once, before the first sample."""
@@ -462,19 +445,14 @@ def observer_step(obs, state, t, q, qd, tau):
 def _step_converted(obs, state, q, qd, tau, lost, dt):
     """Make the step again with its inputs converted; raise what failed."""
     n = obs.n
-    q, qd = vector('q', q, n), vector('qd', qd, n)
-    tau = _vector('tau', tau, n)
-    for name in ('S', 'r', 'beta_prev'):
-        x = getattr(state, name)
-        if not (type(x) is np.ndarray and x.dtype == np.float64
-                and x.shape == (n,) and x.flags.c_contiguous
-                and x.flags.writeable):
-            raise DynamicsInputError(
-                f'state.{name}: must be a writeable float64 array of {n} '
-                f'values (initial_state makes one)')
-    code = _step_strict(obs._packed, q, qd, tau, lost, dt, obs.ws.ws,
-                        obs.ws.cw, obs._buf, state.S, state.r,
-                        state.beta_prev)
+    q, qd, tau = (vector(k, x, n) for k, x in
+                  (('q', q), ('qd', qd), ('tau', tau)))
+    try:
+        code = _step_strict(obs._packed, q, qd, tau, vector('lost', lost, n),
+                            dt, obs.ws.ws, obs.ws.cw, obs._buf, state.S,
+                            state.r, state.beta_prev)
+    except Refused:
+        raise DynamicsInputError('state: not made by initial_state') from None
     if code < 0:
         return
     if _BAD_TORQUE <= code < _BAD_TORQUE + n:
@@ -516,10 +494,8 @@ def external_wrench(obs, q, r, out=None):
     except Refused:                 # not float64 arrays: convert, again
         code = None
     if code is None or code >= 0:
-        n = obs.n
-        q = vector('q', q, n)
-        r = _vector('r', r, n)
-        F = out_array(out, (6,))
+        q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
+            out, (6,))
         code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
                               obs.ws.frames, obs.J, obs._A, obs._y, F)
         if code >= 0:
