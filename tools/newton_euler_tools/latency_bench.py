@@ -18,8 +18,8 @@ Measure latency: joint state in, torques out, through the real ROS graph.
     python -m newton_euler_tools.latency_bench [--duration S] [--quick]
                                              [--json PATH] [--rate HZ]
 
-Four phases, each in a ROS domain of its own (``--domain`` and the next
-three ids; default ROS_DOMAIN_ID when set, else 64), on loopback
+Five phases, each in a ROS domain of its own (``--domain`` and the next
+four ids; default ROS_DOMAIN_ID when set, else 64), on loopback
 discovery:
 
 1. **inverse_dynamics_node** (the node under test) is started as its own
@@ -29,18 +29,28 @@ discovery:
    its numba kernels at start; up to ``--startup-timeout`` s), a driver in
    this process publishes ``sensor_msgs/JointState`` for the 6 Puma joints
    (a seeded random walk of positions and velocities within the joint
-   limits) at ``--rate`` Hz for ``--duration`` s, with header.stamp = the
+   limits, with efforts: the Puma model's own torques for that motion)
+   at ``--rate`` Hz for ``--duration`` s, with header.stamp = the
    send time (this process's ``time.time_ns()``, the clock ROS's system
    time uses).  Every ``/inverse_dynamics_node/torques`` message is matched
    to its input by stamp: latency = receive time - header.stamp; dropped =
    sent - received after a short drain.  The node spins its default
-   SingleThreadedExecutor; a second run of it with
-   ``NEWTON_EULER_EXECUTOR=events`` (the EventsExecutor) shows the
-   trade-off between the two executors: CPU and p99 against memory that
-   stays bounded under a flood.
-2. **echo_node** (:mod:`newton_euler_tools.echo_node`), the same
+   SingleThreadedExecutor.
+2. **observer on** (domain + 4): the same node with
+   ``observer.enabled: true`` (a second ``--params-file``, written to
+   ``build/latency_bench/observer_params.yaml``), fed the same states:
+   the observer's cost in the node, side by side with phase 1.  The
+   bench also takes ``~/external_wrench`` and ``~/contact``: the phase
+   fails (exit 2) when fewer than half of the answered JointStates came
+   with their wrench, i.e. when the observer did not run.  The efforts
+   are the model's torques, so the residual stays small (only the send
+   jitter against the walk's 1 ms steps) and no contact fires.
+3. A second run of phase 1 with ``NEWTON_EULER_EXECUTOR=events`` (the
+   EventsExecutor) shows the trade-off between the two executors: CPU
+   and p99 against memory that stays bounded under a flood.
+4. **echo_node** (:mod:`newton_euler_tools.echo_node`), the same
    message work with no dynamics, measured the same way: the floor.
-3. **self-loop**: the bench publishes to a subscription of its own, no
+5. **self-loop**: the bench publishes to a subscription of its own, no
    other process: what the bench's own send and receive paths cost (no
    transport: FastDDS delivers within a process directly).
 
@@ -77,8 +87,9 @@ the node does before ``~/torques``, dearer.
 
 Targets (PASS/MISS, from this run's numbers): node p99 < 1 ms; nothing
 dropped; overhead over the echo floor, (node - echo) / echo, < 50% on p50
-and on p99.  The exit code is 0 when the run completed (1 with ``--strict``
-and a MISS), 2 when it could not run.
+and on p99; with the observer on, p99 < 1 ms and nothing dropped.  The
+exit code is 0 when the run completed (1 with ``--strict`` and a MISS),
+2 when it could not run.
 """
 import argparse
 import array

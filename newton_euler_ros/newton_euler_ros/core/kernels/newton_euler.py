@@ -306,7 +306,7 @@ def coriolis_matrix_columns(links, frames, q, qd, ws, scratch, C):
 @njit(cache=True)
 def momentum_terms(links, frames, q, qd, ws, cw, out):
     """
-    p = D(q) qd, C(q, qd)^T qd and g(q) in one O(n) recursion.
+    Compute D(q) qd, C(q, qd)^T qd and g(q) in one O(n) recursion.
 
     What the momentum observer needs at each sample, into the rows 0, 1,
     2 of ``out`` (3, n), without forming D or C.  With the body Jacobians
