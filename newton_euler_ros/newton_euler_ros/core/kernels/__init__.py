@@ -23,7 +23,8 @@ file                   what it holds
                        force and moment) and the backward pass (tip to
                        base: the force balance, the joint torques), with
                        the tip wrench beside them; g(q); D and C column by
-                       column from unit inputs
+                       column from unit inputs; D qd, C^T qd and g in one
+                       recursion (the momentum observer's terms)
 ``crba.py``            D(q) by the composite-rigid-body algorithm
 ``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
 ``aba.py``             qdd by the articulated-body algorithm
