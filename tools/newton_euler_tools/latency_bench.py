@@ -18,8 +18,8 @@ Measure latency: joint state in, torques out, through the real ROS graph.
     python -m newton_euler_tools.latency_bench [--duration S] [--quick]
                                              [--json PATH] [--rate HZ]
 
-Four phases, each in a ROS domain of its own (``--domain`` and the next
-three ids; default ROS_DOMAIN_ID when set, else 64), on loopback
+Five phases, each in a ROS domain of its own (``--domain`` and the next
+four ids; default ROS_DOMAIN_ID when set, else 64), on loopback
 discovery:
 
 1. **inverse_dynamics_node** (the node under test) is started as its own
@@ -29,18 +29,28 @@ discovery:
    its numba kernels at start; up to ``--startup-timeout`` s), a driver in
    this process publishes ``sensor_msgs/JointState`` for the 6 Puma joints
    (a seeded random walk of positions and velocities within the joint
-   limits) at ``--rate`` Hz for ``--duration`` s, with header.stamp = the
+   limits, with efforts: the Puma model's own torques for that motion)
+   at ``--rate`` Hz for ``--duration`` s, with header.stamp = the
    send time (this process's ``time.time_ns()``, the clock ROS's system
    time uses).  Every ``/inverse_dynamics_node/torques`` message is matched
    to its input by stamp: latency = receive time - header.stamp; dropped =
    sent - received after a short drain.  The node spins its default
-   SingleThreadedExecutor; a second run of it with
-   ``NEWTON_EULER_EXECUTOR=events`` (the EventsExecutor) shows the
-   trade-off between the two executors: CPU and p99 against memory that
-   stays bounded under a flood.
-2. **echo_node** (:mod:`newton_euler_tools.echo_node`), the same
+   SingleThreadedExecutor.
+2. **observer on** (domain + 4): the same node with
+   ``observer.enabled: true`` (a second ``--params-file``, written to
+   ``build/latency_bench/observer_params.yaml``), fed the same states:
+   the observer's cost in the node, side by side with phase 1.  The
+   bench also takes ``~/external_wrench`` and ``~/contact``: the phase
+   fails (exit 2) when fewer than half of the answered JointStates came
+   with their wrench, i.e. when the observer did not run.  The efforts
+   are the model's torques, so the residual stays small (only the send
+   jitter against the walk's 1 ms steps) and no contact fires.
+3. A second run of phase 1 with ``NEWTON_EULER_EXECUTOR=events`` (the
+   EventsExecutor) shows the trade-off between the two executors: CPU
+   and p99 against memory that stays bounded under a flood.
+4. **echo_node** (:mod:`newton_euler_tools.echo_node`), the same
    message work with no dynamics, measured the same way: the floor.
-3. **self-loop**: the bench publishes to a subscription of its own, no
+5. **self-loop**: the bench publishes to a subscription of its own, no
    other process: what the bench's own send and receive paths cost (no
    transport: FastDDS delivers within a process directly).
 
@@ -77,8 +87,9 @@ the node does before ``~/torques``, dearer.
 
 Targets (PASS/MISS, from this run's numbers): node p99 < 1 ms; nothing
 dropped; overhead over the echo floor, (node - echo) / echo, < 50% on p50
-and on p99.  The exit code is 0 when the run completed (1 with ``--strict``
-and a MISS), 2 when it could not run.
+and on p99; with the observer on, p99 < 1 ms and nothing dropped.  The
+exit code is 0 when the run completed (1 with ``--strict`` and a MISS),
+2 when it could not run.
 """
 import argparse
 import array
@@ -102,6 +113,8 @@ REPO_DIR = os.path.dirname(os.path.dirname(PACKAGE_DIR))
 
 NODE_NAME = 'inverse_dynamics_node'
 NODE_TOPIC = '/inverse_dynamics_node/torques'
+WRENCH_TOPIC = '/inverse_dynamics_node/external_wrench'
+CONTACT_TOPIC = '/inverse_dynamics_node/contact'
 ECHO_TOPIC = '/echo_node/torques'
 LOOP_TOPIC = '/latency_bench/loop'
 INPUT_TOPIC = '/joint_states'
@@ -111,8 +124,16 @@ FALLBACK_LIMITS = ((-2.7925, 2.7925), (-0.7854, 3.9270), (-3.9270, 0.7854),
                    (-1.9199, 2.9671), (-1.7453, 1.7453), (-4.6426, 4.6426))
 
 TARGET_P99_US = 1000.0
+WALL_STIFFNESS = 400.0          # 1/s^2: the walk's turn-back spring
 TARGET_OVERHEAD = 0.50          # (node - echo) / echo, on p50 and on p99
-DEFAULT_DOMAIN = 64             # phases use DOMAIN .. DOMAIN + 3
+DEFAULT_DOMAIN = 64             # phases use DOMAIN .. DOMAIN + 4
+DOMAINS = 5
+# the observer phase fails when fewer answered JointStates than this share
+# came with their ~/external_wrench (the observer did not run)
+MIN_OBSERVED = 0.5
+OBSERVER_PARAMS = ('# written by newton_euler_tools.latency_bench: the observer '
+                   'phase\ninverse_dynamics_node:\n  ros__parameters:\n'
+                   '    observer:\n      enabled: true\n')
 
 _CDR_LE = b'\x00\x01'
 _STAMP = struct.Struct('<iI')   # header.stamp.sec, .nanosec after the
@@ -208,7 +229,7 @@ class BenchSide:
     """
 
     def __init__(self, domain, pub_topic, sub_topic, executor_kind,
-                 command_topic=None, name='latency_bench'):
+                 command_topic=None, name='latency_bench', extra=()):
         import rclpy
         from rclpy.qos import QoSProfile, ReliabilityPolicy
         from rclpy.signals import SignalHandlerOptions
@@ -243,6 +264,15 @@ class BenchSide:
                 self.node.create_subscription(
                     Float64MultiArray, command_topic,
                     _recorder(self.commands),
+                    QoSProfile(depth=1000,
+                               reliability=ReliabilityPolicy.RELIABLE),
+                    raw=True)
+            # more raw subscriptions, kept like the answers: {topic: list}
+            self.extra, self.extra_subs = {}, {}
+            for topic, msg_type in extra:
+                self.extra[topic] = []
+                self.extra_subs[topic] = self.node.create_subscription(
+                    msg_type, topic, _recorder(self.extra[topic]),
                     QoSProfile(depth=1000,
                                reliability=ReliabilityPolicy.RELIABLE),
                     raw=True)
@@ -301,28 +331,49 @@ def raw_stamp_ns(raw):
 # input: a random walk within the joint limits
 
 
-def joint_limits():
+def puma_model():
+    """Return the bundled puma560 model (None if it cannot be read)."""
     try:
         import warnings
         from newton_euler_ros.core import load_robot
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')
             model = load_robot('puma560')
-        lims = tuple((lim['lower'], lim['upper']) for lim in model.limits)
-        if len(lims) == len(JOINTS):
-            return lims
+        return model if model.n == len(JOINTS) else None
     except Exception:
-        pass
+        return None
+
+
+def joint_limits(model=None):
+    if model is not None:
+        return tuple((lim['lower'], lim['upper']) for lim in model.limits)
     return FALLBACK_LIMITS
 
 
-def random_walk(n, rate, seed, limits):
+class Walk:
+    """The joint states of a phase: positions, velocities, efforts."""
+
+    def __init__(self, positions, velocities, efforts):
+        self.positions = positions
+        self.velocities = velocities
+        self.efforts = efforts
+
+    def __len__(self):
+        return len(self.positions)
+
+
+def random_walk(n, rate, seed, limits, model=None):
     """
-    Return n positions and n velocities as array('d'), 1/rate s apart.
+    Return a :class:`Walk` of n states 1/rate s apart, as array('d').
 
     The accelerations are a random walk (smooth, bounded motion),
-    velocities are capped at 2 rad/s, positions reflect at 90% of the
-    limits.
+    velocities are capped at 2 rad/s, and a joint beyond 90% of its
+    range is turned back by a stiff spring (velocities stay continuous;
+    it stays within its limits).  The efforts are ``model``'s own
+    torques for the motion, tau(q, qd, qdd) with qdd the acceleration
+    the walk integrated: what the drives of that arm would report, so a
+    momentum observer on the same model sees no external torque (empty
+    without a model).
     """
     rng = np.random.default_rng(seed)
     lo = np.array([a for a, _ in limits])
@@ -335,16 +386,25 @@ def random_walk(n, rate, seed, limits):
     qdd = np.zeros(6)
     pos = np.empty((n, 6))
     vel = np.empty((n, 6))
+    acc = np.empty((n, 6))
     for k in range(n):
         qdd = 0.995 * qdd + rng.normal(0.0, 0.5, 6)
-        qd = np.clip(qd + qdd * dt, -2.0, 2.0)
+        # the wall: zero at 90% of the range, so no jump in acceleration
+        wall = WALL_STIFFNESS * (np.minimum(hi - q, 0.0)
+                                 + np.maximum(lo - q, 0.0))
+        new_qd = np.clip(qd + (qdd + wall) * dt, -2.0, 2.0)
+        acc[k] = (new_qd - qd) / dt
+        qd = new_qd
         q = q + qd * dt
-        over, under = q > hi, q < lo
-        q = np.where(over, 2 * hi - q, np.where(under, 2 * lo - q, q))
-        qd = np.where(over | under, -qd, qd)
         pos[k], vel[k] = q, qd
-    return ([array.array('d', p) for p in pos],
-            [array.array('d', v) for v in vel])
+    if model is not None:
+        from newton_euler_ros.core import inverse_dynamics_batch
+        eff = inverse_dynamics_batch(model, pos, vel, acc)
+        efforts = [array.array('d', e) for e in eff]
+    else:
+        efforts = [array.array('d')] * n
+    return Walk([array.array('d', p) for p in pos],
+                [array.array('d', v) for v in vel], efforts)
 
 
 # --------------------------------------------------------------------------
@@ -377,7 +437,7 @@ def _set_stamp(msg, t):
     msg.header.stamp.nanosec = t % 1_000_000_000
 
 
-def wait_ready(bench, child, timeout, clock, positions, velocities):
+def wait_ready(bench, child, timeout, clock, walk):
     """
     Wait until matched both ways and a warm-up message is answered.
 
@@ -397,21 +457,26 @@ def wait_ready(bench, child, timeout, clock, positions, velocities):
             raise BenchError(f'receive thread failed: {bench.spin_errors}')
 
     while (bench.pub.get_subscription_count() < 1
-           or bench.sub.get_publisher_count() < 1):
+           or bench.sub.get_publisher_count() < 1
+           or any(sub.get_publisher_count() < 1
+                  for sub in bench.extra_subs.values())):
         check_child()
         if time.monotonic() > end:
             raise BenchError(
                 f'not matched after {timeout:.0f} s (subscribers of the '
                 f'input: {bench.pub.get_subscription_count()}, publishers '
-                f'of the output: {bench.sub.get_publisher_count()})'
+                f'of the output: {bench.sub.get_publisher_count()}'
+                + ''.join(f', of {t}: {sub.get_publisher_count()}'
+                          for t, sub in bench.extra_subs.items()) + ')'
                 + (':\n' + child.tail() if child is not None else ''))
         time.sleep(0.02)
     msg = _new_msg()
     k = 0
     while True:
         check_child()
-        msg.position, msg.velocity = positions[k % len(positions)], \
-            velocities[k % len(velocities)]
+        i = k % len(walk)
+        msg.position, msg.velocity, msg.effort = walk.positions[i], \
+            walk.velocities[i], walk.efforts[i]
         stamp = clock()
         _set_stamp(msg, stamp)
         n = len(bench.received)
@@ -450,13 +515,14 @@ def check_answer(answer, sent, kind):
     return problems
 
 
-def paced_send(bench, n_slots, rate, clock, positions, velocities, spin_s,
-               record=True):
+def paced_send(bench, n_slots, rate, clock, walk, spin_s, record=True):
     """Publish at absolute perf_counter deadlines; returns the record."""
     perf = time.perf_counter
     perf_ns = time.perf_counter_ns
     sleep = time.sleep
     publish = bench.pub.publish
+    positions, velocities, efforts = walk.positions, walk.velocities, \
+        walk.efforts
     msg = _new_msg()
     stamp = msg.header.stamp
     period = 1.0 / rate
@@ -482,6 +548,7 @@ def paced_send(bench, n_slots, rate, clock, positions, velocities, spin_s,
             pass
         msg.position = positions[k]
         msg.velocity = velocities[k]
+        msg.effort = efforts[k]
         t = clock()
         stamp.sec = t // 1_000_000_000
         stamp.nanosec = t % 1_000_000_000
@@ -511,6 +578,7 @@ def summarize(send, received, rate):
     sent = set(send['stamps'])
     seen = set()
     lat = []
+    first = last = None
     duplicates = unknown = 0
     for recv_ns, raw in received:
         s = raw_stamp_ns(raw)
@@ -521,6 +589,8 @@ def summarize(send, received, rate):
         else:
             seen.add(s)
             lat.append(recv_ns - s)
+            first = recv_ns if first is None else min(first, recv_ns)
+            last = recv_ns if last is None else max(last, recv_ns)
     lat_us = np.array(lat, dtype=np.float64) / 1e3
     n_sent = len(send['stamps'])
     pub_us = np.frombuffer(send['publish_ns'], dtype=np.int64) / 1e3
@@ -531,6 +601,10 @@ def summarize(send, received, rate):
         'send_rate_hz': ((n_sent - 1) / send['span_s']
                          if send['span_s'] > 0 else float('nan')),
         'target_rate_hz': rate,
+        # answers per second, from the first answer's arrival to the last
+        'answer_rate_hz': ((len(lat) - 1) / ((last - first) * 1e-9)
+                           if len(lat) > 1 and last > first
+                           else float('nan')),
         'latency_us': {
             'p50': _pct(lat_us, 50), 'p90': _pct(lat_us, 90),
             'p99': _pct(lat_us, 99), 'p99.9': _pct(lat_us, 99.9),
@@ -558,8 +632,13 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
     result = {'label': label, 'domain': domain,
               'command': cmd, 'load_average_start': _loadavg()}
     n_slots = int(round(args.duration * args.rate))
-    positions, velocities = random_walk(n_slots, args.rate, args.seed,
-                                        args.limits)
+    walk = random_walk(n_slots, args.rate, args.seed, args.limits,
+                       args.model)
+    extra = ()
+    if key == 'observer':
+        from geometry_msgs.msg import WrenchStamped
+        from std_msgs.msg import Bool
+        extra = ((WRENCH_TOPIC, WrenchStamped), (CONTACT_TOPIC, Bool))
     clock = _StampClock()
     child = None
     bench = None
@@ -573,10 +652,10 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
                          if cmd and args.also_command else None)
         bench = BenchSide(domain, LOOP_TOPIC if cmd is None else
                           INPUT_TOPIC, sub_topic, args.bench_executor,
-                          command_topic)
+                          command_topic, extra=extra)
         result['bench_executor'] = bench.executor_name
         waited, answer, sent = wait_ready(
-            bench, child, args.startup_timeout, clock, positions, velocities)
+            bench, child, args.startup_timeout, clock, walk)
         problems = check_answer(answer, sent, key)
         result['startup_s'] = waited
         result['answer_problems'] = problems
@@ -591,9 +670,9 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
                 'topics; choose another --domain')
         if args.preroll > 0:
             paced_send(bench, int(args.preroll * args.rate), args.rate,
-                       clock, positions, velocities, args.spin_us * 1e-6,
-                       record=False)
+                       clock, walk, args.spin_us * 1e-6, record=False)
         commands0 = len(bench.commands)
+        extra0 = {t: len(box) for t, box in bench.extra.items()}
         cpu0 = _cpu_seconds(child.pid) if child else None
         own0 = time.process_time()
         t0 = time.monotonic()
@@ -603,22 +682,28 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
         if not args.keep_gc:
             gc.disable()   # no collector pauses in the bench while timing
         try:
-            send = paced_send(bench, n_slots, args.rate, clock, positions,
-                              velocities, args.spin_us * 1e-6)
+            send = paced_send(bench, n_slots, args.rate, clock, walk,
+                              args.spin_us * 1e-6)
             wall = time.monotonic() - t0
             cpu1 = _cpu_seconds(child.pid) if child else None
             own1 = time.process_time()
             # drain: until every answer is in, or --drain s
             end = time.monotonic() + args.drain
             want = set(send['stamps'])
+            wrenches = bench.extra.get(WRENCH_TOPIC)
             while time.monotonic() < end:
                 got = sum(1 for _, raw in bench.received
                           if raw_stamp_ns(raw) in want)
+                if wrenches is not None:    # and every wrench
+                    got = min(got, sum(1 for _, raw in wrenches
+                                       if raw_stamp_ns(raw) in want))
                 if got >= len(want):
                     break
                 time.sleep(0.02)
             received = list(bench.received)
             commands = len(bench.commands) - commands0
+            extras = {t: list(box[extra0[t]:])
+                      for t, box in bench.extra.items()}
         finally:
             sys.setswitchinterval(old_switch)
             if gc_was_enabled:
@@ -652,7 +737,61 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
     log(f'latency us: p50 {L["p50"]:.0f}  p99 {L["p99"]:.0f}  p99.9 '
         f'{L["p99.9"]:.0f}  max {L["max"]:.0f};  sent {stats["sent"]}  '
         f'received {stats["received"]}  dropped {stats["dropped"]}')
+    if key == 'observer':
+        result['observer'] = observer_check(send, received, extras)
     return result, lat_us
+
+
+def observer_check(send, received, extras):
+    """
+    Return what the node's observer published in the timed run, or raise.
+
+    Every answered JointState should come with its ``~/external_wrench``
+    (stamped with the JointState's stamp); fewer than ``MIN_OBSERVED`` of
+    them means the observer did not run and the phase measured the node
+    without it: BenchError.  Also the wrench's latency (receive time -
+    stamp), its largest force and moment, and whether ``~/contact`` was
+    ever true (the efforts are the model's own torques: it should not).
+    """
+    from geometry_msgs.msg import WrenchStamped
+    from rclpy.serialization import deserialize_message
+    sent = set(send['stamps'])
+    answered = {raw_stamp_ns(raw) for _, raw in received} & sent
+    lat, seen, f_max, m_max, finite = [], set(), 0.0, 0.0, True
+    for recv_ns, raw in extras.get(WRENCH_TOPIC, []):
+        s = raw_stamp_ns(raw)
+        if s not in sent or s in seen:
+            continue
+        seen.add(s)
+        lat.append((recv_ns - s) / 1e3)
+        w = deserialize_message(raw, WrenchStamped).wrench
+        f = (w.force.x, w.force.y, w.force.z)
+        m = (w.torque.x, w.torque.y, w.torque.z)
+        finite &= bool(np.isfinite(f + m).all())
+        f_max = max(f_max, float(np.linalg.norm(f)))
+        m_max = max(m_max, float(np.linalg.norm(m)))
+    contacts = extras.get(CONTACT_TOPIC, [])
+    out = {'answered': len(answered), 'wrenches': len(seen),
+           'wrench_latency_us': {'p50': _pct(lat, 50), 'p99': _pct(lat, 99)},
+           'max_force_n': f_max, 'max_moment_nm': m_max,
+           'wrench_finite': finite,
+           'contact_messages': len(contacts),
+           'contact_true': sum(1 for _, raw in contacts
+                               if len(raw) > 4 and raw[4] != 0)}
+    log(f'observer: {out["wrenches"]} ~/external_wrench for '
+        f'{out["answered"]} answered JointStates (latency p50 '
+        f'{out["wrench_latency_us"]["p50"]:.0f} / p99 '
+        f'{out["wrench_latency_us"]["p99"]:.0f} us); largest |f| '
+        f'{f_max:.2f} N, |m| {m_max:.2f} N m; ~/contact true in '
+        f'{out["contact_true"]} of {out["contact_messages"]} messages')
+    if not answered or len(seen) < MIN_OBSERVED * len(answered):
+        raise BenchError(
+            f'observer phase: {len(seen)} ~/external_wrench for '
+            f'{len(answered)} answered JointStates: the observer did not '
+            f'run (see the node log), so this phase measured nothing')
+    if not finite:
+        raise BenchError('observer phase: a non-finite ~/external_wrench')
+    return out
 
 
 # --------------------------------------------------------------------------
@@ -694,20 +833,23 @@ def verdicts(node, echo):
 
 
 def print_table(phases):
-    head = (f'{"":30s}{"p50":>7s}{"p99":>8s}{"p99.9":>8s}{"max":>8s}'
-            f'{"sent":>8s}{"recv":>8s}{"drop":>6s}{"rate Hz":>9s}'
-            f'{"cpu%":>6s}')
+    head = (f'{"":36s}{"p50":>7s}{"p99":>8s}{"p99.9":>8s}{"max":>8s}'
+            f'{"sent":>8s}{"recv":>8s}{"drop":>6s}{"sent Hz":>9s}'
+            f'{"ans Hz":>8s}{"cpu%":>6s}')
     log('latency = receive time - header.stamp, in us')
     log(head)
     log('-' * len(head))
     for r in phases:
         L = r['latency_us']
         cpu = r.get('node_cpu_percent')
-        log(f'{r["label"]:30s}{L["p50"]:7.0f}{L["p99"]:8.0f}'
+        log(f'{r["label"]:36s}{L["p50"]:7.0f}{L["p99"]:8.0f}'
             f'{L["p99.9"]:8.0f}{L["max"]:8.0f}{r["sent"]:8d}'
             f'{r["received"]:8d}{r["dropped"]:6d}{r["send_rate_hz"]:9.1f}'
+            f'{r["answer_rate_hz"]:8.1f}'
             + (f'{cpu:6.0f}' if cpu is not None else f'{"-":>6s}'))
-    log('(cpu% = the node process, % of one core, during the timed run)')
+    log('(sent Hz / ans Hz = joint states sent / answers received per '
+        'second; cpu% = the node process, % of one core, during the timed '
+        'run)')
     for r in phases:
         P, S = r['publish_call_us'], r['send_lateness_us']
         log(f'  {r["label"]}: publish() call p50 {P["p50"]:.1f} / p99 '
@@ -736,8 +878,9 @@ def parse_args(argv=None):
                         help='publishing rate, Hz (default 1000)')
     parser.add_argument('--domain', type=int, default=None,
                         help='ROS domain of the first phase; the others '
-                             'use the next ids (default ROS_DOMAIN_ID when '
-                             f'set, else {DEFAULT_DOMAIN})')
+                             f'use the next {DOMAINS - 1} ids (default '
+                             'ROS_DOMAIN_ID when set, else '
+                             f'{DEFAULT_DOMAIN})')
     parser.add_argument('--seed', type=int, default=1,
                         help='seed of the random walk (default 1)')
     parser.add_argument('--startup-timeout', type=float, default=60.0,
@@ -766,7 +909,8 @@ def parse_args(argv=None):
     parser.add_argument('--no-timer-slack', action='store_true',
                         help="keep the sending thread's default timer slack")
     parser.add_argument('--skip', action='append', default=[],
-                        choices=('node', 'events', 'echo', 'loop'),
+                        choices=('node', 'observer', 'events', 'echo',
+                                 'loop'),
                         help='leave a phase out (repeatable)')
     parser.add_argument('--also-command', action='store_true',
                         help='also subscribe ~/torque_command (counted, not '
@@ -787,11 +931,11 @@ def parse_args(argv=None):
         parser.error('--duration and --rate must be > 0')
     if args.domain is None:
         try:
-            args.domain = first_domain(DEFAULT_DOMAIN, 4)
+            args.domain = first_domain(DEFAULT_DOMAIN, DOMAINS)
         except ValueError as exc:
             parser.error(str(exc))
-    if not 0 <= args.domain <= 229:
-        parser.error('--domain must be in 0..229')
+    if not 0 <= args.domain <= 232 - (DOMAINS - 1):
+        parser.error(f'--domain must be in 0..{232 - (DOMAINS - 1)}')
     return args
 
 
@@ -813,11 +957,16 @@ def print_header(args, rclpy_version, slack, load_start):
         f'{args.switch_us:g} us during timing')
 
 
-def phase_plan(args):
+def phase_plan(args, observer_params):
     """(key, label, domain, command, topic, env) of each phase to run."""
     node_cmd = (shlex.split(args.node_cmd) if args.node_cmd
                 else node_command())
+    # the observer on: the same command, one more parameters file
+    observer_cmd = node_cmd + ['--ros-args', '--params-file',
+                               observer_params]
     return [('node', f'{NODE_NAME}', args.domain, node_cmd, NODE_TOPIC, None),
+            ('observer', f'{NODE_NAME}, observer on', args.domain + 4,
+             observer_cmd, NODE_TOPIC, None),
             ('events', f'{NODE_NAME}, events', args.domain + 3, node_cmd,
              NODE_TOPIC, {'NEWTON_EULER_EXECUTOR': 'events'}),
             ('echo', 'echo_node (floor)', args.domain + 1,
@@ -827,13 +976,45 @@ def phase_plan(args):
              None)]
 
 
+def observer_verdicts(off, on):
+    """Targets of the observer phase (and its figures beside ``off``)."""
+    L = on['latency_us']
+    out = {'targets': {
+        'observer on: p99 < 1 ms': {'value': L['p99'], 'unit': 'us',
+                                    'pass': bool(L['p99'] < TARGET_P99_US)},
+        'observer on: nothing dropped': {'value': on['dropped'],
+                                         'unit': 'messages',
+                                         'pass': on['dropped'] == 0}}}
+    if off is not None:
+        out['added_p50_us'] = L['p50'] - off['latency_us']['p50']
+        out['added_p99_us'] = L['p99'] - off['latency_us']['p99']
+    return out
+
+
+def _side_by_side(off, on):
+    """Log the observer off / on figures on one line each."""
+    def pair(key):
+        return (f'{off["latency_us"][key]:.0f} / '
+                f'{on["latency_us"][key]:.0f}')
+    cpu = [r.get('node_cpu_percent') for r in (off, on)]
+    log(f'\nobserver off / on ({NODE_NAME}, SingleThreadedExecutor): p50 '
+        f'{pair("p50")} us, p99 {pair("p99")} us, max {pair("max")} us; '
+        f'answered {off["answer_rate_hz"]:.1f} / {on["answer_rate_hz"]:.1f}'
+        f' Hz of {on["target_rate_hz"]:.0f}; dropped {off["dropped"]} / '
+        f'{on["dropped"]}'
+        + (f'; node cpu {cpu[0]:.0f}% / {cpu[1]:.0f}%'
+           if None not in cpu else ''))
+
+
 def report(phases, by_key):
     """Log the table, the node/echo verdicts; return (summary, missed)."""
     print_table(phases)
     summary = None
     missed = False
+    targets = {}
     if 'node' in by_key and 'echo' in by_key:
         summary = verdicts(by_key['node'], by_key['echo'])
+        targets.update(summary['targets'])
         log(f'\nnode / echo: p50 {summary["ratio_p50"]:.2f}x, p99 '
             f'{summary["ratio_p99"]:.2f}x;  overhead over the echo floor: '
             f'p50 {100 * summary["overhead_p50"]:+.0f}%, p99 '
@@ -844,26 +1025,42 @@ def report(phases, by_key):
                 f'{lp["p50"]:.0f} us = {100 * lp["p50"] / ep["p50"]:.0f}% of '
                 f'the echo floor p50 ({ep["p50"]:.0f} us), p99 '
                 f'{lp["p99"]:.0f} us')
+    if 'observer' in by_key:
+        on = by_key['observer']
+        ov = observer_verdicts(by_key.get('node'), on)
+        summary = dict(summary or {}, observer=ov)
+        targets.update(ov['targets'])
+        if 'node' in by_key:
+            _side_by_side(by_key['node'], on)
+        o = on['observer']
+        log(f'the observer ran: {o["wrenches"]} ~/external_wrench for '
+            f'{o["answered"]} answered JointStates; largest |f| '
+            f'{o["max_force_n"]:.2f} N, |m| {o["max_moment_nm"]:.2f} N m; '
+            f'~/contact true in {o["contact_true"]} of '
+            f'{o["contact_messages"]} messages')
+    if targets:
+        summary['targets'] = targets
         log('\ntargets:')
-        for name, t in summary['targets'].items():
+        for name, t in targets.items():
             value = ('no answers' if t['value'] != t['value'] else
                      f'{t["value"]:.0f} {t["unit"]}' if t['unit'] != '%'
                      else f'{t["value"]:+.0f}%')
             log(f'  {name:40s} {"PASS" if t["pass"] else "MISS"}  ({value})')
             missed |= not t['pass']
-        if 'events' in by_key:
-            ev, nd = by_key['events'], by_key['node']
-            log(f'executor trade-off: the default SingleThreadedExecutor p50 '
-                f'{nd["latency_us"]["p50"]:.0f} / p99 '
-                f'{nd["latency_us"]["p99"]:.0f} us at '
-                f'{nd.get("node_cpu_percent", float("nan")):.0f}% CPU; '
-                f'NEWTON_EULER_EXECUTOR=events p50 '
-                f'{ev["latency_us"]["p50"]:.0f} / p99 '
-                f'{ev["latency_us"]["p99"]:.0f} us at '
-                f'{ev.get("node_cpu_percent", float("nan")):.0f}% CPU, but '
-                f'memory unbounded under a flood (test_load_node.py)')
-        codes = ', '.join(f'{r["label"]} {r["exit_code"]}'
-                          for r in phases if 'exit_code' in r)
+    if 'node' in by_key and 'events' in by_key:
+        ev, nd = by_key['events'], by_key['node']
+        log(f'executor trade-off: the default SingleThreadedExecutor p50 '
+            f'{nd["latency_us"]["p50"]:.0f} / p99 '
+            f'{nd["latency_us"]["p99"]:.0f} us at '
+            f'{nd.get("node_cpu_percent", float("nan")):.0f}% CPU; '
+            f'NEWTON_EULER_EXECUTOR=events p50 '
+            f'{ev["latency_us"]["p50"]:.0f} / p99 '
+            f'{ev["latency_us"]["p99"]:.0f} us at '
+            f'{ev.get("node_cpu_percent", float("nan")):.0f}% CPU, but '
+            f'memory unbounded under a flood (test_load_node.py)')
+    codes = ', '.join(f'{r["label"]} {r["exit_code"]}'
+                      for r in phases if 'exit_code' in r)
+    if codes:
         log(f'child exit codes after SIGINT: {codes}')
     return summary, missed
 
@@ -905,7 +1102,12 @@ def main(argv=None):
         rclpy_version = metadata.version('rclpy')
     except metadata.PackageNotFoundError:
         rclpy_version = '?'
-    args.limits = joint_limits()
+    args.model = puma_model()
+    args.limits = joint_limits(args.model)
+    os.makedirs(logs_dir, exist_ok=True)
+    observer_params = os.path.join(logs_dir, 'observer_params.yaml')
+    with open(observer_params, 'w') as fh:
+        fh.write(OBSERVER_PARAMS)
     slack = False if args.no_timer_slack else set_timer_slack(1)
     load_start = _loadavg()
     print_header(args, rclpy_version, slack, load_start)
@@ -914,7 +1116,8 @@ def main(argv=None):
     by_key = {}
     t_start = time.monotonic()
     try:
-        for key, label, domain, cmd, topic, env in phase_plan(args):
+        for key, label, domain, cmd, topic, env in phase_plan(
+                args, observer_params):
             if key in args.skip:
                 continue
             result, _ = run_phase(key, label, domain, cmd, topic, args,

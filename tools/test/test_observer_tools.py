@@ -22,6 +22,18 @@ def test_bench_observer_runs(capsys):
     assert bench_observer.main(['--quick', '--robot', 'planar_2r']) == 0
     out = capsys.readouterr().out
     assert 'observer update' in out and 'us per JointState' in out
+    assert 'with separate D, C, g, J calls' in out
+
+
+@pytest.mark.parametrize('robot', ['panda', 'stanford', 'planar_rp'])
+def test_bench_compares_like_with_like(robot):
+    """The bench's separate-passes update is the observer's, to round-off."""
+    import warnings
+    from newton_euler_ros.core import load_robot
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_robot(robot)
+    assert bench_observer.agreement(model, count=100) < 1e-12
 
 
 def test_example_bag_holds_the_push(tmp_path):

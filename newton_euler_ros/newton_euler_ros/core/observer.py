@@ -68,13 +68,16 @@ import math
 from numba import njit
 import numpy as np
 
-from .dynamics import coriolis_matrix, gravity_torques, jacobian, mass_matrix
+from .calling import (F8, MAT, out_array, PACKED, Refused, status_error,
+                      strict_entry, VEC, vector, workspace)
+from .dynamics import jacobian
 from .errors import DynamicsInputError
-from .kernels import cholesky_solve
-from .kernels._jit import uses_kernels
+from .kernels import (cholesky_solve, NONFINITE, run_jacobian,
+                      run_momentum_terms, SIZE)
+from .kernels._jit import ENTRY, uses_kernels
 from .workspace import Workspace
 
-# this file's compiled functions call cholesky_solve: a kernel edit must
+# this file's compiled functions call kernels: a kernel edit must
 # recompile them (numba's cache stamps a function with its own file only)
 uses_kernels(__file__)
 
@@ -86,39 +89,52 @@ UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \
 # ---------------------------------------------------------------------------
 # compiled arithmetic (no allocation, finiteness checked here)
 
-@njit(cache=True)
-def _update(D, C, g, qd, tau, lost, armature, gain, dt, restart, p, beta,
-            beta_prev, S, r):
-    """
-    One sample: p, beta, then S and r advanced over dt (or restarted).
+# rows of MomentumObserver._buf, the step's buffer (n columns)
+_DQD, _CTQD, _G = 0, 1, 2       # D qd, C^T qd, g (run_momentum_terms)
+_P, _BETA = 3, 4                # momentum and known torque of the sample
+_ARMATURE, _GAIN = 5, 6         # the configuration
+_ROWS = 7
+# the status of a non-finite momentum or known torque at joint i
+_BAD_TORQUE = 2 * NONFINITE
 
-    p = (D + diag(armature)) qd and beta = tau - lost + C^T qd - g are
-    formed first; if one is not finite the state is left untouched and
-    the joint's index returned.  Otherwise S and r advance over ``dt``
-    (or, with ``restart``, S starts at this sample keeping r) and -1 is
-    returned (-2 if r came out non-finite and was reset to 0).
+
+@njit(**ENTRY)
+def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
     """
-    n = qd.shape[0]
+    One sample in one call: D qd, C^T qd, g (one recursion), then S, r.
+
+    p = D qd + armature qd and beta = tau - lost + C^T qd - g; if one is
+    not finite the state is left untouched and ``_BAD_TORQUE`` + the
+    joint returned (a kernel status code for bad q or qd).  Else S and r
+    advance over ``dt`` (``dt <= 0``: S restarts here, keeping r) and -1
+    is returned (-2 if r came out non-finite and was reset to 0).
+    """
+    code = run_momentum_terms(P, q, qd, ws, cw, buf[:3])
+    if code >= 0:
+        return code
+    n = q.shape[0]
+    if (tau.shape[0] != n or lost.shape[0] != n or buf.shape[0] != _ROWS
+            or buf.shape[1] != n or S.shape[0] != n or r.shape[0] != n
+            or beta_prev.shape[0] != n):
+        return SIZE + 2
     for i in range(n):
-        s = armature[i] * qd[i]
-        c = 0.0
-        for j in range(n):
-            s += D[i, j] * qd[j]
-            c += C[j, i] * qd[j]
-        p[i] = s
-        beta[i] = tau[i] - lost[i] + c - g[i]
-        if not (math.isfinite(p[i]) and math.isfinite(beta[i])):
-            return i
+        p = buf[_DQD, i] + buf[_ARMATURE, i] * qd[i]
+        beta = tau[i] - lost[i] + buf[_CTQD, i] - buf[_G, i]
+        if not (math.isfinite(p) and math.isfinite(beta)):
+            return _BAD_TORQUE + i
+        buf[_P, i] = p
+        buf[_BETA, i] = beta
+    restart = not dt > 0.0
     ok = True
     if not restart:
         for i in range(n):
-            k = gain[i]
+            k = buf[_GAIN, i]
             a = math.exp(-k * dt)
             b = 1.0 - a
-            known = 0.5 * dt * (beta[i] + beta_prev[i])
+            known = 0.5 * dt * (buf[_BETA, i] + beta_prev[i])
             # mean external torque over the interval: the momentum
             # change that the known torques do not explain
-            u = (p[i] - (S[i] + r[i] / k) - known) / dt
+            u = (buf[_P, i] - (S[i] + r[i] / k) - known) / dt
             S[i] += known + r[i] * b / k + u * (dt - b / k)
             r[i] = a * r[i] + b * u
             ok &= math.isfinite(r[i]) and math.isfinite(S[i])
@@ -126,12 +142,16 @@ def _update(D, C, g, qd, tau, lost, armature, gain, dt, restart, p, beta,
         if not ok or not math.isfinite(r[i]):
             r[i] = 0.0          # cannot happen for finite input; never
         if restart or not ok:   # hand out NaN
-            S[i] = p[i] - r[i] / gain[i]
-        beta_prev[i] = beta[i]
+            S[i] = buf[_P, i] - r[i] / buf[_GAIN, i]
+        beta_prev[i] = buf[_BETA, i]
     return -1 if ok else -2
 
 
-@njit(cache=True)
+_step_strict = strict_entry(_step, PACKED, VEC, VEC, VEC, VEC, F8, MAT, MAT,
+                            MAT, VEC, VEC, VEC)
+
+
+@njit(**ENTRY)
 def _dls_wrench(J, r, damping, A, y, F):
     """
     F = (J J^T + damping^2 I)^-1 J r, the damped (J^T)^+ r.
@@ -180,7 +200,30 @@ def _dls_wrench(J, r, damping, A, y, F):
     return True
 
 
-@njit(cache=True)
+@njit(**ENTRY)
+def _wrench(P, q, r, damping, ws, Ts, J, A, y, F):
+    """
+    J(q) and the damped least-squares wrench in one compiled call.
+
+    A kernel status code for q (or SIZE + 1 for r), else -1 with F the
+    wrench, or zeros when the solve fails.
+    """
+    code = run_jacobian(P, q, False, ws, Ts, J)
+    if code >= 0:
+        return code
+    if r.shape[0] != J.shape[1] or F.shape[0] != 6:
+        return SIZE + 1
+    if not _dls_wrench(J, r, damping, A, y, F):
+        for a in range(6):
+            F[a] = 0.0
+    return -1
+
+
+_wrench_strict = strict_entry(_wrench, PACKED, VEC, VEC, F8, MAT, MAT, MAT,
+                              MAT, VEC, VEC)
+
+
+@njit(**ENTRY)
 def _contact(r, on, hysteresis, active):
     """Per-joint hysteresis; True when any joint is in contact."""
     any_active = False
@@ -246,7 +289,13 @@ class MomentumObserver:
         n = model.n
         self.model = model
         self.n = n
-        self.gain = _per_joint('gain', gain, n)
+        self.ws = Workspace(model) if ws is None else workspace(model, ws)
+        # the compiled step's buffer: the model terms, p and beta of the
+        # last sample, the armature and the gain (rows _DQD ... _GAIN)
+        self._buf = np.zeros((_ROWS, n))
+        # gain and armature: views of rows of it (change them in place)
+        self.gain = self._buf[_GAIN]
+        self.gain[:] = _per_joint('gain', gain, n)
         self.max_gap = float(max_gap)
         if not (math.isfinite(self.max_gap) and self.max_gap > 0.0):
             raise ValueError(f'max_gap: must be finite and > 0, got '
@@ -255,8 +304,9 @@ class MomentumObserver:
             raise ValueError('drive_torque: must be callable '
                              '(qd, qdd_or_None) -> torque')
         self.drive_torque = drive_torque
-        self.armature = (np.zeros(n) if armature is None else
-                         _per_joint('armature', armature, n, positive=False))
+        self.armature = self._buf[_ARMATURE]
+        if armature is not None:
+            self.armature[:] = _per_joint('armature', armature, n, False)
         self.damping = float(damping)
         if not (math.isfinite(self.damping) and self.damping >= 0.0):
             raise ValueError(f'damping: must be finite and >= 0, got '
@@ -266,16 +316,13 @@ class MomentumObserver:
         if not (0.0 < self.hysteresis <= 1.0):
             raise ValueError(f'hysteresis: must be in (0, 1], got '
                              f'{hysteresis!r}')
-        self.ws = Workspace(model) if ws is None else ws
-        self.D = np.zeros((n, n))
-        self.C = np.zeros((n, n))
-        self.g = np.zeros(n)
         self.J = np.zeros((6, n))
-        self.p = np.zeros(n)
-        self.beta = np.zeros(n)
+        self.p = self._buf[_P]          # momentum of the last sample
+        self.beta = self._buf[_BETA]    # its known torque
         self.lost = np.zeros(n)
         self._A = np.zeros((min(n, 6), min(n, 6)))
         self._y = np.zeros(min(n, 6))
+        self._packed = model.packed
 
     def warm_up(self):
         """Compile (or load) every kernel once, before the first sample."""
@@ -357,44 +404,63 @@ def observer_step(obs, state, t, q, qd, tau):
     ``STARTED`` (first sample), ``RESTARTED`` (gap or stamp backwards),
     ``DUPLICATE`` (same stamp: ignored).  Non-finite or wrongly sized
     input raises :class:`DynamicsInputError` and leaves the state as it
-    was.
+    was.  One compiled call (``_step``): D qd, C^T qd and g from one
+    recursion, then the update.
     """
     t = float(t)
     if not math.isfinite(t):
         raise DynamicsInputError(f'stamp must be finite, got {t!r}')
-    dt = None if state.t_prev is None else t - state.t_prev
-    if dt == 0.0:
-        state.duplicates += 1
-        return state.r, DUPLICATE
-    m = obs.model
-    ws = obs.ws
-    mass_matrix(m, q, ws=ws, out=obs.D)
-    coriolis_matrix(m, q, qd, ws=ws, out=obs.C)
-    gravity_torques(m, q, ws=ws, out=obs.g)
-    qd = _vector('qd', qd, obs.n)
-    tau = _vector('tau', tau, obs.n)
-    if obs.drive_torque is not None:
-        lost = _vector('drive_torque', obs.drive_torque(qd, None), obs.n)
+    t_prev = state.t_prev
+    if t_prev is None:
+        dt, what = 0.0, STARTED
     else:
+        dt = t - t_prev
+        if dt == 0.0:
+            state.duplicates += 1
+            return state.r, DUPLICATE
+        if dt < 0.0 or dt > obs.max_gap:
+            dt, what = 0.0, RESTARTED       # restart: the sum starts here
+        else:
+            what = UPDATED
+    if obs.drive_torque is None:
         lost = obs.lost
-    restart = dt is None or dt < 0.0 or dt > obs.max_gap
-    bad = _update(obs.D, obs.C, obs.g, qd, tau, lost, obs.armature,
-                  obs.gain, 0.0 if restart else dt, restart, obs.p, obs.beta,
-                  state.beta_prev, state.S, state.r)
-    if bad >= 0:
-        raise DynamicsInputError(
-            f'non-finite momentum or torque at joint '
-            f'{m.joint_names[bad]!r} (effort {float(tau[bad])!r})')
-    if not restart:
-        what = UPDATED
-    elif dt is None:
-        what = STARTED
     else:
-        what = RESTARTED
+        qd = _vector('qd', qd, obs.n)
+        lost = _vector('drive_torque', obs.drive_torque(qd, None), obs.n)
+    try:
+        code = _step_strict(obs._packed, q, qd, tau, lost, dt, obs.ws.ws,
+                            obs.ws.cw, obs._buf, state.S, state.r,
+                            state.beta_prev)
+    except Refused:                 # not float64 arrays: convert, again
+        code = None
+    if code is None or code >= 0:
+        _step_converted(obs, state, q, qd, tau, lost, dt)
+    if what is RESTARTED:
         state.restarts += 1
     state.t_prev = t
     state.samples += 1
     return state.r, what
+
+
+def _step_converted(obs, state, q, qd, tau, lost, dt):
+    """Make the step again with its inputs converted; raise what failed."""
+    n = obs.n
+    q, qd, tau = (vector(k, x, n) for k, x in
+                  (('q', q), ('qd', qd), ('tau', tau)))
+    try:
+        code = _step_strict(obs._packed, q, qd, tau, vector('lost', lost, n),
+                            dt, obs.ws.ws, obs.ws.cw, obs._buf, state.S,
+                            state.r, state.beta_prev)
+    except Refused:
+        raise DynamicsInputError('state: not made by initial_state') from None
+    if code < 0:
+        return
+    if _BAD_TORQUE <= code < _BAD_TORQUE + n:
+        i = code - _BAD_TORQUE
+        raise DynamicsInputError(
+            f'non-finite momentum or torque at joint '
+            f'{obs.model.joint_names[i]!r} (effort {float(tau[i])!r})')
+    raise status_error(code, (q, qd))
 
 
 def _vector(name, x, n):
@@ -418,13 +484,22 @@ def external_wrench(obs, q, r, out=None):
     ``[fx, fy, fz, mx, my, mz]`` in base axes, moment about the
     end-effector origin (force/torque sensor sign; ``-F_e`` of the
     dynamics' input convention), the damped least-squares solution of
-    ``J(q)^T F = r``.  Zeros if the solve fails (never NaN).
+    ``J(q)^T F = r``.  Zeros if the solve fails (never NaN).  One
+    compiled call (``_wrench``): J(q), then the solve.
     """
-    J = jacobian(obs.model, q, 'base', ws=obs.ws, out=obs.J)
     F = np.empty(6) if out is None else out
-    if not _dls_wrench(J, _vector('r', r, obs.n), obs.damping, obs._A,
-                       obs._y, F):
-        F[:] = 0.0
+    try:
+        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
+                              obs.ws.frames, obs.J, obs._A, obs._y, F)
+    except Refused:                 # not float64 arrays: convert, again
+        code = None
+    if code is None or code >= 0:
+        q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
+            out, (6,))
+        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
+                              obs.ws.frames, obs.J, obs._A, obs._y, F)
+        if code >= 0:
+            raise status_error(code, (q,))
     return F
 
 

@@ -43,6 +43,7 @@ def args():
         'composite': True, 'in_ee_axes': False, 'ws': ws.ws, 'aw': ws.aw,
         'cw': ws.cw, 'scratch': ws.scratch, 'Ts': ws.frames,
         'D': np.empty((n, n)), 'C': np.empty((n, n)), 'J': np.empty((6, n)),
+        'terms': np.empty((3, n)),
     }
 
 

@@ -260,6 +260,8 @@ def _run_every_kernel(mod, model, dtype):
                                        M) == -1
     assert mod.run_jacobian(P, q, True, ws, Ts, J) == -1
     assert mod.run_link_poses(P, q, ws, Ts) == -1
+    terms = np.zeros((3, n), f)
+    assert mod.run_momentum_terms(P, q, q, ws, cw, terms) == -1
     flags = mod.flags(True, True, mod.WRENCH_NONE)
     assert mod.run_inverse_dynamics_batch(P, Q, Q, Q, W, flags, ws, TAU,
                                           status) == -1

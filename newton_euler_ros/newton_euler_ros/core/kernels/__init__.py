@@ -23,7 +23,8 @@ file                   what it holds
                        force and moment) and the backward pass (tip to
                        base: the force balance, the joint torques), with
                        the tip wrench beside them; g(q); D and C column by
-                       column from unit inputs
+                       column from unit inputs; D qd, C^T qd and g in one
+                       recursion (the momentum observer's terms)
 ``crba.py``            D(q) by the composite-rigid-body algorithm
 ``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
 ``aba.py``             qdd by the articulated-body algorithm
@@ -80,7 +81,7 @@ from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
                      W_WIDTH, WRENCH_BASE, WRENCH_EE, WRENCH_NONE,
                      WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
-                           recursion, unit_columns)
+                           momentum_terms, recursion, unit_columns)
 from .status import check_finite, first_nonfinite, round_into
 
 __all__ = [
@@ -93,7 +94,8 @@ __all__ = [
     'first_nonfinite', 'flags', 'forward_kinematics', 'GRAVITY',
     'jacobian', 'joint_trig', 'L_BODY', 'L_COM', 'L_INERTIA', 'L_MASS',
     'L_P', 'L_R', 'L_TYPE', 'L_WIDTH', 'mass_matrix_columns',
-    'mass_matrix_crba', 'NONFINITE', 'OVERFLOW', 'pack', 'recursion',
+    'mass_matrix_crba', 'momentum_terms', 'NONFINITE', 'OVERFLOW', 'pack',
+    'recursion',
     'round_into', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
     'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
     'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',

@@ -50,7 +50,7 @@ from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, NONFINITE,  # noqa
                      OVERFLOW, SINGULAR, SIZE, VELOCITY, W_WIDTH,
                      WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
-                           mass_matrix_columns, recursion)
+                           mass_matrix_columns, momentum_terms, recursion)
 from .regressor import drive_columns, regressor_columns
 from .status import first_nonfinite, matrix_status
 
@@ -113,6 +113,12 @@ def coriolis_matrix_row(links, frames, q, qd, composite, ws, cw, scratch, C):
     if composite:
         return coriolis_matrix_composite(links, frames, q, qd, ws, cw, C)
     return coriolis_matrix_columns(links, frames, q, qd, ws, scratch, C)
+
+
+@njit(cache=True, inline='always')
+def momentum_terms_row(links, frames, q, qd, ws, cw, terms):
+    """D qd, C^T qd and g into the rows of ``terms`` (3, n), one recursion."""
+    return momentum_terms(links, frames, q, qd, ws, cw, terms)
 
 
 # not inlined into its entry point (numba's inline='always'): the
@@ -190,6 +196,7 @@ run_mass_matrix = entry(mass_matrix_row)
 run_coriolis_matrix = entry(coriolis_matrix_row)
 run_coriolis_matrix_batch = batch(coriolis_matrix_composite_row,
                                   'run_coriolis_matrix_batch')
+run_momentum_terms = entry(momentum_terms_row)
 run_forward_dynamics = entry(forward_dynamics_row)
 run_forward_dynamics_batch = batch(forward_dynamics_row)
 run_jacobian = entry(jacobian_row)

@@ -53,6 +53,7 @@ SHAPES = {
     'ws': ('>=n', 'W_WIDTH'), 'aw': ('>=n + 1', 'A_WIDTH'),
     'cw': ('>=n + 1', 'CW_WIDTH'), 'scratch': ('3', '>=n'),
     'Ts': ('n + 2', '12'),
+    'terms': ('3', 'n'),
 }
 # input a of the status codes (``calling.INPUTS``, ``calling.FD_INPUTS``)
 INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3}
