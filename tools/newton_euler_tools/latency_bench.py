@@ -163,12 +163,11 @@ def prepare_environment(build_dir):
     """
     Set this process's environment before rclpy starts.
 
-    Loopback discovery; logs and the numba cache under build/ unless set.
+    Loopback discovery; logs under build/ unless set (the numba cache
+    is where the package keeps it).
     """
     os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
     os.environ.setdefault('ROS_LOG_DIR', os.path.join(build_dir, 'ros_log'))
-    os.environ.setdefault('NUMBA_CACHE_DIR',
-                          os.path.join(build_dir, 'numba-cache'))
     os.makedirs(os.environ['ROS_LOG_DIR'], exist_ok=True)
 
 

@@ -45,7 +45,8 @@ def test_first_domain_reads_ros_domain_id(monkeypatch):
             first_domain(64, count)
 
 
-@pytest.mark.parametrize('module', ['demo', 'demo_pick', 'latency_bench'])
+@pytest.mark.parametrize('module', ['demo', 'demo_pick', 'demo_identify',
+                                    'latency_bench'])
 def test_unusable_ros_domain_id_stops_at_once(module, tmp_path):
     proc = subprocess.run(
         [sys.executable, '-m', f'newton_euler_tools.{module}', '--quick',
