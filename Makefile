@@ -72,7 +72,8 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_identify
 
 # identification alone: 40 s recording time; 1 and 30 min time and peak
-# memory (about 10 minutes: writing and reading the 30 min bag dominates)
+# memory (about a minute and a half: writing and reading the 30 min bag
+# dominates)
 bench-identify: setup
 	$(PY) -m newton_euler_tools.bench_identify
 

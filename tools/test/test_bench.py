@@ -21,3 +21,10 @@ def test_effect_benchmark_runs(capsys):
     assert bench_effects.main(['puma_payload_press', '--quick']) == 0
     out = capsys.readouterr().out
     assert 'without friction' in out and 'none (D qdd only)' in out
+
+
+def test_bench_compare_refuses_what_is_not_a_checkout(tmp_path, capsys):
+    from newton_euler_tools import bench_compare
+    assert bench_compare.main([str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and 'not a checkout of this repository' in err[0]
