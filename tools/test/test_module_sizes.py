@@ -12,14 +12,12 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""No module of the tools is longer than MAX_LINES (known exceptions aside)."""
+"""No module of the tools is longer than MAX_LINES."""
 from pathlib import Path
 
 import newton_euler_tools
 
 MAX_LINES = 600
-# latency_bench.py is being extended elsewhere; split it, then drop it here
-EXCEPTIONS = {'latency_bench.py'}
 
 
 def test_no_tools_module_is_too_long():
@@ -28,13 +26,7 @@ def test_no_tools_module_is_too_long():
     for path in sorted(root.rglob('*.py')):
         name = path.relative_to(root).as_posix()
         lines = len(path.read_text(encoding='utf-8').splitlines())
-        if lines > MAX_LINES and name not in EXCEPTIONS:
+        if lines > MAX_LINES:
             long[name] = lines
     assert not long, (f'modules over {MAX_LINES} lines (split them into '
                       f'set-up, measure and report): {long}')
-
-
-def test_the_exceptions_still_exist():
-    root = Path(newton_euler_tools.__file__).parent
-    for name in EXCEPTIONS:
-        assert (root / name).is_file(), f'{name} is gone: drop it here'
