@@ -83,7 +83,7 @@ FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
             'end_effector': 'end_effector', 'ee_link': 'end_effector'}
 GRACE = 1.0     # seconds between seeing a controller and starting
 LEAD = 0.5      # seconds between announcing the start time and t = 0
-FIRST_COMMAND = 1.0     # seconds t = 0 is held for the first command
+FIRST_COMMAND = 5.0     # seconds t = 0 is held for the first command
 FUTURE = 1.0    # seconds: a live wrench stamped further ahead is dropped
 
 
@@ -260,6 +260,10 @@ class RobotSimNode(Node):
               and now - self.first_state_ns < FIRST_COMMAND * 1e9):
             return      # hold t = 0 until the first command answers it
         else:
+            if self.ticks == 0 and self.wait and not self.commanded:
+                self.get_logger().warning(
+                    f'no command within {FIRST_COMMAND:g} s of t = 0: the '
+                    'simulation starts without one (last torques held)')
             self.ticks += 1
             t_next = self.ticks * self.period
             if t_next <= self.scene.duration + 1e-9:
