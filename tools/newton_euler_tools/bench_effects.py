@@ -24,12 +24,13 @@ side by side in one run; and the same for one simulation step.
 """
 import argparse
 import dataclasses
-import time
 import warnings
 
 from newton_euler_ros.sim.scene import load_scene
 from newton_euler_ros.sim.simulate import SceneDynamics
 import numpy as np
+
+from .timing import min_time
 
 EFFECTS = ('gravity', 'velocity_products', 'payload', 'wrench', 'friction',
            'armature')
@@ -37,14 +38,7 @@ EFFECTS = ('gravity', 'velocity_products', 'payload', 'wrench', 'friction',
 
 def _min_time(fn, number, repeat):
     """Return the best time per call of ``fn`` in microseconds."""
-    fn()
-    best = float('inf')
-    for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - start) / number)
-    return best * 1e6
+    return min_time(fn, number, repeat) * 1e6
 
 
 def variants(scene):

@@ -31,7 +31,6 @@ in a mean; the load average is printed beside them.
 import argparse
 import math
 import os
-import time
 import warnings
 
 from newton_euler_ros.core import load_robot
@@ -44,6 +43,8 @@ from newton_euler_ros.core.observer import (contact_step, external_wrench,
                                             MomentumObserver, observer_step)
 from numba import njit
 import numpy as np
+
+from .timing import min_time
 
 TARGET_US = 10.0
 
@@ -153,14 +154,7 @@ class SeparatePasses:
 
 def _min_time(fn, number, repeat):
     """Return the best time per call of ``fn`` in microseconds."""
-    fn()
-    best = float('inf')
-    for _ in range(repeat):
-        start = time.perf_counter()
-        for _ in range(number):
-            fn()
-        best = min(best, (time.perf_counter() - start) / number)
-    return best * 1e6
+    return min_time(fn, number, repeat) * 1e6
 
 
 def states(model, count, seed=0):

@@ -23,26 +23,17 @@ a user stacks it for identification, per state.  Both on the same
 published URDFs (example-robot-data).  Target: ours <= 0.5x Pinocchio.
 """
 import argparse
-import time
 import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.regressor import regressor_batch
 import numpy as np
 
+from .timing import min_time
+
 TARGET = 0.5
 ROBOTS = (('panda', 'panda_description/urdf/panda.urdf', 'panda_hand_tcp'),
           ('ur5', 'ur_description/urdf/ur5_robot.urdf', 'tool0'))
-
-
-def _best(fn, repeat):
-    fn()
-    best = float('inf')
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def measure(label, relative, tip, m, repeat):
@@ -67,7 +58,7 @@ def measure(label, relative, tip, m, repeat):
             pin.computeJointTorqueRegressor(peer.model, peer.data, X[i],
                                             QD[i], QDD[i])
 
-    return _best(ours, repeat) / m, _best(theirs, repeat) / m
+    return min_time(ours, 1, repeat) / m, min_time(theirs, 1, repeat) / m
 
 
 def main(argv=None):

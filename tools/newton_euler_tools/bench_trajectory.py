@@ -24,24 +24,15 @@ from the positions, against a Python loop of single ``inverse_dynamics``
 calls over the same points, side by side in one run.
 """
 import argparse
-import time
 import warnings
 
 from newton_euler_ros.core import inverse_dynamics, load_robot
 from newton_euler_ros.core.trajectory import trajectory_efforts
 import numpy as np
 
+from .timing import min_time
+
 POINTS = 1000
-
-
-def _best(fn, repeat):
-    fn()
-    best = float('inf')
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - start)
-    return best
 
 
 def main(argv=None):
@@ -73,11 +64,11 @@ def main(argv=None):
         def loop():
             for k in range(POINTS):
                 inverse_dynamics(model, Q[k], QD[k], QDD[k])
-        cells = [_best(lambda: trajectory_efforts(model, names, full),
-                       repeat),
-                 _best(lambda: trajectory_efforts(model, names, bare),
-                       repeat),
-                 _best(loop, repeat)]
+        cells = [min_time(lambda: trajectory_efforts(model, names, full),
+                          1, repeat),
+                 min_time(lambda: trajectory_efforts(model, names, bare),
+                          1, repeat),
+                 min_time(loop, 1, repeat)]
         print(f'{name:<10}' + ''.join(
             f'{c / POINTS * 1e6:>{w}.2f}' for c, w in zip(cells,
                                                           (16, 12, 14))))

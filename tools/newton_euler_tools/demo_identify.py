@@ -71,6 +71,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from .demo import base_domain, DemoError
+from .demo_identify_report import prepare_plots, write_report
 from .demo_identify_runs import drive, LoopRun, wait_until
 from .ident_example import BASE, panda_path, perturb_urdf, TIP
 
@@ -250,13 +251,6 @@ def write_scene(path, robot_file, duration):
         f.write('\n'.join(lines))
 
 
-def plan_at(times, segment):
-    """Planned positions at the given times."""
-    ts, Q = segment[0], segment[1]
-    return np.column_stack([np.interp(times, ts, Q[:, j])
-                            for j in range(Q.shape[1])])
-
-
 def load_segment(path):
     """(t, Q, QD, QDD) of a trajectory JSON."""
     with open(path, encoding='utf-8') as f:
@@ -290,46 +284,175 @@ def quiet_load(path):
         return load_robot(path, base=BASE, tip=TIP)
 
 
-def prepare_plots():
-    """Import matplotlib (Agg), a second or two, ahead of :func:`plot`."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot  # noqa: F401
+# the runs, as the report names them
+PUBLISHED = 'published URDF'
+IDENTIFIED = 'identified URDF + drive compensation'
+UNTOLD = f'{PAYLOAD["mass"]:g} kg payload, node not told'
+TOLD = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
 
 
-def plot(runs, segment, truth, out):
-    """Tracking error and feedforward torque error per run."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(9, 4))
-    for label, r in runs.items():
-        err = np.linalg.norm(r['q'] - plan_at(r['t'], segment), axis=1)
-        ax.semilogy(r['t'], err + 1e-9, label=label, lw=0.9)
-    ax.set_xlabel('simulated time (s)')
-    ax.set_ylabel('|q - q_plan| (rad)')
-    ax.set_title('Panda: tracking error along the excitation trajectory')
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, 'tracking.png'), dpi=100)
-    plt.close(fig)
-    fig, axes = plt.subplots(7, 1, sharex=True, figsize=(9, 12))
-    t = segment[0]
-    for j, ax in enumerate(axes):
-        for label, r in runs.items():
-            ax.plot(t, r['ff'][:, j] - truth[label][:, j], lw=0.8,
-                    label=label)
-        ax.set_ylabel(f'joint {j + 1}\nN m', fontsize=8)
-    axes[0].set_title('feedforward effort minus the true torque')
-    axes[0].legend(fontsize=7, ncol=2)
-    axes[-1].set_xlabel('time along the plan (s)')
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, 'torques.png'), dpi=90)
-    plt.close(fig)
+class Loop:
+    """
+    The demo's six steps, one method each, in the order they run.
+
+    A run's nodes start while an earlier step works, so the methods hand
+    runs on through attributes: ``first`` (the published URDF),
+    ``second`` and ``third`` (the identified URDF, without and with the
+    payload), ``last`` (the estimate applied).  ``live`` lists what to
+    stop if anything fails.
+    """
+
+    def __init__(self, args, out, base, started):
+        self.args, self.out = args, out
+        self.log_dir = os.path.join(out, 'logs')
+        os.makedirs(self.log_dir, exist_ok=True)
+        self.steps = Steps(started)
+        self.domains = iter(range(base, base + 4))
+        self.period, self.periods, self.harmonics, self.budget = (
+            QUICK if args.quick else FULL)
+        self.duration = self.period * self.periods + 0.5
+        self.live = []
+        self.runs = {}
+        self.truth = {}
+
+    def path(self, name):
+        """Return the path of a file in the demo's output folder."""
+        return os.path.join(self.out, name)
+
+    def start_run(self, label, **kw):
+        """Start a run's nodes in the next ROS domain."""
+        run = LoopRun(label, self.scene, next(self.domains), self.log_dir,
+                      **kw)
+        self.live.append(run)
+        return run
+
+    def excite(self):
+        """1: the plant's files, the first run's nodes, ``excite``."""
+        self.steps.begin('excite', '[1/6] newton-euler excite; the nodes '
+                         'of the first run start meanwhile')
+        self.published = self.path('panda_published.urdf')
+        shutil.copyfile(panda_path(), self.published)
+        nominal = quiet_load(self.published)
+        with open(self.published, encoding='utf-8') as f:
+            text = f.read()
+        real = self.path('panda_real.urdf')
+        with open(real, 'w', encoding='utf-8') as f:
+            f.write(real_plant_urdf(text, set(nominal.info['urdf']['links']),
+                                    self.args.seed))
+        truth_model = quiet_load(real)
+        self.scene = self.path('panda_real.yaml')
+        write_scene(self.scene, real, self.duration)
+        self.first = self.start_run('published', urdf=self.published)
+        warm_excite(nominal)
+        traj = self.path('excitation.json')
+        newton_euler('excite', self.published, '--base', BASE, '--tip', TIP,
+                     '-o', traj, '--period', self.period, '--harmonics',
+                     self.harmonics, '--seconds', self.period * self.periods,
+                     '--budget', self.budget, '--start', *START,
+                     log=self.path('excite.txt'))
+        self.steps.end()
+        self.segment = load_segment(traj)
+        # the plant's torque along the plan; computed now, it also puts the
+        # batch kernel the node fills the plan with in numba's cache
+        bare = true_torques(truth_model, self.segment)
+        held = true_torques(truth_model, self.segment, PAYLOAD)
+        self.truth = {PUBLISHED: bare, IDENTIFIED: bare, UNTOLD: held,
+                      TOLD: held}
+
+    def record_published(self):
+        """2: the plan through the node with the published URDF, recorded."""
+        first = self.first
+        self.steps.begin('published', '[2/6] run with the published URDF, '
+                         'recording /joint_states')
+        wait_until([first], first.ready, 'the nodes of the first run')
+        first.go(self.segment)
+        wait_until([first], first.begun, 'the simulation start')
+        # the next two runs' nodes start now; their URDF comes later
+        self.second = self.start_run('identified', compensate=True)
+        self.third = self.start_run('payload_untold', compensate=True,
+                                    plant_payload=PAYLOAD)
+        drive([first], self.duration)
+        self.bag1 = self.path('recording')
+        self.runs[PUBLISHED] = first.finish(self.duration, bag=self.bag1)
+        self.steps.end()
+
+    def identify(self):
+        """3: ``identify`` on the recording; the last run's nodes start."""
+        self.steps.begin('identify', '[3/6] newton-euler identify; the '
+                         'nodes of the last run start meanwhile')
+        self.last = self.start_run('payload_told', compensate=True,
+                                   plant_payload=PAYLOAD)
+        self.identified = self.path('panda_identified.urdf')
+        newton_euler('identify', self.published, self.bag1, '--base', BASE,
+                     '--tip', TIP, '-o', self.identified,
+                     log=self.path('identify.txt'))
+        self.steps.end()
+
+    def record_identified(self):
+        """4: the identified URDF, without and with the untold payload."""
+        second, third = self.second, self.third
+        self.steps.begin(
+            'identified + untold', '[4/6] two runs at once, the node given '
+            'the identified URDF (robot_description) + drive compensation: '
+            f'as is, and with {PAYLOAD["mass"]:g} kg picked up (node not '
+            'told), recorded')
+        with open(self.identified, encoding='utf-8') as f:
+            identified_text = f.read()
+        for r in (second, third, self.last):
+            r.describe(identified_text)
+        wait_until([second, third], lambda: second.ready() and third.ready(),
+                   'the nodes of the second and third runs')
+        second.go(self.segment)
+        third.go(self.segment)
+        wait_until([second, third],
+                   lambda: all([second.begun(), third.begun()]),
+                   'the simulation start')
+        drive([second, third], self.duration)
+        self.bag2 = self.path('payload_recording')
+        self.runs[IDENTIFIED] = second.finish(self.duration)
+        self.runs[UNTOLD] = third.finish(self.duration, bag=self.bag2)
+        self.steps.end()
+
+    def estimate_payload(self):
+        """5: ``payload --json`` on the second recording."""
+        self.steps.begin('payload', '[5/6] newton-euler payload --json')
+        self.estimate = json.loads(newton_euler(
+            'payload', self.identified, self.bag2, '--base', BASE, '--tip',
+            TIP, '--json', log=self.path('payload.json')))
+        self.steps.end()
+
+    def apply_estimate(self):
+        """6: the estimate set on the node in one call, the plan again."""
+        last = self.last
+        self.steps.begin('estimate applied', '[6/6] the estimate set on the '
+                         'node (set_parameters_atomically), run again')
+        wait_until([last], last.ready, 'the nodes of the last run')
+        last.rec.set_payload(self.estimate)
+        last.go(self.segment)
+        wait_until([last], last.begun, 'the simulation start')
+        prepare_plots()         # while the last run runs
+        drive([last], self.duration)
+        self.runs[TOLD] = last.finish(self.duration)
+        self.steps.end()
+
+    def run(self):
+        """All six steps; DemoError if one fails (every run stopped)."""
+        try:
+            self.excite()
+            self.record_published()
+            self.identify()
+            self.record_identified()
+            self.estimate_payload()
+            self.apply_estimate()
+            for r in (self.first, self.second, self.third, self.last):
+                r.close()
+        finally:
+            for item in reversed(self.live):
+                item.abort()
 
 
-def main(argv=None):
-    """Run the loop; return the exit status."""
+def parse_args(argv):
+    """Parse the demo's command line."""
     parser = argparse.ArgumentParser(
         prog='python -m newton_euler_tools.demo_identify',
         description=__doc__.strip().split('\n')[0])
@@ -338,207 +461,29 @@ def main(argv=None):
     parser.add_argument('--quick', action='store_true',
                         help='a short trajectory and optimisation (tests)')
     parser.add_argument('--seed', type=int, default=7)
-    args = parser.parse_args(argv)
+    return parser.parse_args(argv)
+
+
+def main(argv=None):
+    """Run the loop; return the exit status."""
+    args = parse_args(argv)
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
     started = time.monotonic()
     out = os.path.abspath(args.out)
-    log_dir = os.path.join(out, 'logs')
-    os.makedirs(log_dir, exist_ok=True)
+    os.makedirs(out, exist_ok=True)
     keep_bytecode(out)
-    period, periods, harmonics, budget = QUICK if args.quick else FULL
     try:
         base = base_domain(4)
     except ValueError as exc:
         print(f'demo_identify: {exc}', file=sys.stderr)
         return 2
-    steps = Steps(started)
-    live = []           # the runs to stop if anything fails
+    loop = Loop(args, out, base, started)
     try:
-        domains = iter(range(base, base + 4))
-        published = os.path.join(out, 'panda_published.urdf')
-        shutil.copyfile(panda_path(), published)
-        duration = period * periods + 0.5
-        traj = os.path.join(out, 'excitation.json')
-        steps.begin('excite', '[1/6] newton-euler excite; the nodes of the '
-                    'first run start meanwhile')
-        nominal = quiet_load(published)
-        with open(published, encoding='utf-8') as f:
-            text = f.read()
-        real = os.path.join(out, 'panda_real.urdf')
-        with open(real, 'w', encoding='utf-8') as f:
-            f.write(real_plant_urdf(text, set(nominal.info['urdf']['links']),
-                                    args.seed))
-        truth_model = quiet_load(real)
-        scene = os.path.join(out, 'panda_real.yaml')
-        write_scene(scene, real, duration)
-        first = LoopRun('published', scene, next(domains), log_dir,
-                        urdf=published)
-        live.append(first)
-        warm_excite(nominal)
-        newton_euler('excite', published, '--base', BASE, '--tip', TIP, '-o',
-                     traj, '--period', period, '--harmonics', harmonics,
-                     '--seconds', period * periods, '--budget', budget,
-                     '--start', *START, log=os.path.join(out, 'excite.txt'))
-        steps.end()
-        segment = load_segment(traj)
-        # the plant's torque along the plan; computed now, it also puts the
-        # batch kernel the node fills the plan with in numba's cache
-        bare = true_torques(truth_model, segment)
-        held = true_torques(truth_model, segment, PAYLOAD)
-        published_key = 'published URDF'
-        identified_key = 'identified URDF + drive compensation'
-        untold = f'{PAYLOAD["mass"]:g} kg payload, node not told'
-        told = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
-        truth = {published_key: bare, identified_key: bare, untold: held,
-                 told: held}
-        runs = {}
-        steps.begin('published', '[2/6] run with the published URDF, '
-                    'recording /joint_states')
-        wait_until([first], first.ready, 'the nodes of the first run')
-        first.go(segment)
-        wait_until([first], first.begun, 'the simulation start')
-        # the next two runs' nodes start now; their URDF comes later
-        second = LoopRun('identified', scene, next(domains), log_dir,
-                         compensate=True)
-        third = LoopRun('payload_untold', scene, next(domains), log_dir,
-                        compensate=True, plant_payload=PAYLOAD)
-        live += [second, third]
-        drive([first], duration)
-        bag1 = os.path.join(out, 'recording')
-        runs[published_key] = first.finish(duration, bag=bag1)
-        steps.end()
-        identified = os.path.join(out, 'panda_identified.urdf')
-        steps.begin('identify', '[3/6] newton-euler identify; the nodes of '
-                    'the last run start meanwhile')
-        last = LoopRun('payload_told', scene, next(domains), log_dir,
-                       compensate=True, plant_payload=PAYLOAD)
-        live.append(last)
-        newton_euler('identify', published, bag1, '--base', BASE, '--tip',
-                     TIP, '-o', identified,
-                     log=os.path.join(out, 'identify.txt'))
-        with open(identified, encoding='utf-8') as f:
-            identified_text = f.read()
-        steps.end()
-        steps.begin('identified + untold', '[4/6] two runs at once, the '
-                    'node given the identified URDF (robot_description) + '
-                    f'drive compensation: as is, and with {PAYLOAD["mass"]:g}'
-                    ' kg picked up (node not told), recorded')
-        for r in (second, third, last):
-            r.describe(identified_text)
-        wait_until([second, third], lambda: second.ready() and third.ready(),
-                   'the nodes of the second and third runs')
-        second.go(segment)
-        third.go(segment)
-        wait_until([second, third],
-                   lambda: all([second.begun(), third.begun()]),
-                   'the simulation start')
-        drive([second, third], duration)
-        bag2 = os.path.join(out, 'payload_recording')
-        runs[identified_key] = second.finish(duration)
-        runs[untold] = third.finish(duration, bag=bag2)
-        steps.end()
-        steps.begin('payload', '[5/6] newton-euler payload --json')
-        estimate = json.loads(newton_euler(
-            'payload', identified, bag2, '--base', BASE, '--tip', TIP,
-            '--json', log=os.path.join(out, 'payload.json')))
-        steps.end()
-        steps.begin('estimate applied', '[6/6] the estimate set on the node '
-                    '(set_parameters_atomically), run again')
-        wait_until([last], last.ready, 'the nodes of the last run')
-        last.rec.set_payload(estimate)
-        last.go(segment)
-        wait_until([last], last.begun, 'the simulation start')
-        prepare_plots()         # while the last run runs
-        drive([last], duration)
-        runs[told] = last.finish(duration)
-        steps.end()
-        plot(runs, segment, truth, out)
-        for r in (first, second, third, last):
-            r.close()
+        loop.run()
     except DemoError as exc:
         print(f'demo_identify: {exc}', file=sys.stderr)
         return 1
-    finally:
-        for item in reversed(live):
-            item.abort()
-    rows = []
-    figures = {}
-    for label, r in runs.items():
-        ff = r['ff'] - truth[label]
-        ff_rms = float(np.sqrt(np.mean(ff ** 2)))
-        ff_rel = ff_rms / float(np.sqrt(np.mean(truth[label] ** 2)))
-        err = r['q'] - plan_at(r['t'], segment)
-        tr_rms = float(np.sqrt(np.mean(err ** 2)))
-        tr_max = float(np.abs(err).max())
-        figures[label] = {'ff_rms': ff_rms, 'ff_rel': ff_rel,
-                          'tracking_rms': tr_rms, 'tracking_max': tr_max}
-        rows.append(f'| {label} | {ff_rms:.3f} | {100 * ff_rel:.1f} % | '
-                    f'{1000 * tr_rms:.2f} | {1000 * tr_max:.2f} |')
-    wall = time.monotonic() - started
-    with open(os.path.join(out, 'excite.txt'), encoding='utf-8') as f:
-        excite_lines = [x for x in f.read().splitlines()
-                        if 'condition number' in x]
-    with open(os.path.join(out, 'identify.txt'), encoding='utf-8') as f:
-        ident_lines = [x for x in f.read().splitlines()
-                       if x.startswith(('rank', 'identified in'))]
-    m, c = estimate['payload.mass'], estimate['payload.com']
-    lines = [
-        '# The identification loop, end to end',
-        '',
-        f'`make demo-identify` ({"quick, " if args.quick else ""}'
-        f'{wall:.0f} s wall). The plant (robot_sim_node) is a Panda whose '
-        f'links differ from the published URDF (masses +-15 %, centres of '
-        f'mass +-15 mm, inertias +-25 %) with joint friction and rotor '
-        f'inertia; inverse_dynamics_node starts with the published URDF. '
-        f'An excitation trajectory ({periods} x {period:g} s, {harmonics} '
-        f'harmonics) runs through the node (`~/trajectory_in` -> '
-        f'`~/trajectory_out`) into the simulator (PD + the efforts, as '
-        f'joint_trajectory_controller); `/joint_states` is recorded to a '
-        f'rosbag2; `newton-euler identify` corrects the URDF; the same '
-        f'trajectory runs with the identified URDF (on `robot_description`)'
-        f' and `drives.compensate:=true`, and at the same time, in another '
-        f'ROS domain, with the plant holding {PAYLOAD["mass"]:g} kg the node '
-        f'is not told of; `newton-euler payload` estimates the payload from '
-        "that recording, and a last run has the estimate in the node's "
-        f'`payload.*` (one `set_parameters_atomically` call).',
-        '',
-        '| run | feedforward torque error, RMS (N m) | relative to the true '
-        'torque | tracking error, RMS (mrad) | max (mrad) |',
-        '|---|---|---|---|---|',
-        *rows,
-        '',
-        'Feedforward torque error: the efforts the node filled in, against '
-        'the true torque of the plant along the plan (its real inertials, '
-        'friction and rotor inertia, the payload when held). Tracking error: '
-        'the joint positions against the plan.',
-        '',
-        f'- excite: {excite_lines[0].strip() if excite_lines else ""}',
-        *[f'- identify: {x}' for x in ident_lines],
-        f'- payload estimate: {m:.3f} kg (true {PAYLOAD["mass"]:g}), com '
-        f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm (true '
-        f'[{", ".join(f"{1000 * v:.1f}" for v in PAYLOAD["com"])}])',
-        '- wall time per step (s; the nodes of a run start while an earlier '
-        'step works): ' + ', '.join(f'{k} {v:.1f}'
-                                    for k, v in steps.times.items()),
-        '',
-        'Files: `excitation.json`, `recording/` and `payload_recording/` '
-        '(rosbag2), `panda_identified.urdf`, the output of the commands '
-        '(`excite.txt`, `identify.txt`, `payload.json`), the logs of the '
-        'nodes in `logs/`.',
-        '',
-        '![tracking error](tracking.png)',
-        '',
-        '![feedforward torque error](torques.png)', '']
-    with open(os.path.join(out, 'summary.md'), 'w', encoding='utf-8') as f:
-        f.write('\n'.join(lines))
-    with open(os.path.join(out, 'summary.json'), 'w', encoding='utf-8') as f:
-        json.dump({'runs': figures, 'payload_estimate': estimate,
-                   'payload_true': PAYLOAD, 'wall_s': wall,
-                   'steps_s': steps.times,
-                   'runs_timing_s': {r.label: r.timing(started) for r in (
-                       first, second, third, last)}}, f, indent=1)
-    print('\n'.join(lines[4:6 + len(rows)]))
-    print(f'wrote {out} ({wall:.0f} s)', flush=True)
+    write_report(loop, PAYLOAD, started)
     return 0
 
 

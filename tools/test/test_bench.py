@@ -28,3 +28,13 @@ def test_bench_compare_refuses_what_is_not_a_checkout(tmp_path, capsys):
     assert bench_compare.main([str(tmp_path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and 'not a checkout of this repository' in err[0]
+
+
+def test_trajectory_benchmark_runs(capsys):
+    """Smoke test: one row per robot, three positive figures each."""
+    from newton_euler_tools import bench_trajectory
+    assert bench_trajectory.main(['--quick']) == 0
+    rows = [line.split() for line in capsys.readouterr().out.splitlines()
+            if line.startswith(('puma560', 'panda'))]
+    assert [r[0] for r in rows] == ['puma560', 'panda']
+    assert all(float(x) > 0.0 for r in rows for x in r[1:])

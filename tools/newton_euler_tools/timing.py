@@ -1,0 +1,34 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""The best-of-R wall time the small benchmarks share."""
+import time
+
+
+def min_time(fn, number=1, repeat=5):
+    """
+    Return the best time per call of ``fn``, in seconds.
+
+    ``fn`` is called once first (JIT loading, caches), then ``repeat``
+    times ``number`` calls are timed; the fastest repetition counts (the
+    least disturbed by the rest of the machine).
+    """
+    fn()
+    best = float('inf')
+    for _ in range(repeat):
+        start = time.perf_counter()
+        for _ in range(number):
+            fn()
+        best = min(best, (time.perf_counter() - start) / number)
+    return best
