@@ -134,11 +134,12 @@ def regressor_batch(model, Q, QD, QDD, *, drives=False,
     ws = np.empty((n, K.W_WIDTH))
     line = np.empty((n, 6))
     acc = np.empty((10 * n, 6))
-    code = K.run_regressor_batch(model.packed, Q, QD, QDD, bool(drives), eps,
-                                 ws, line, acc, out)
-    if code != -1:      # sizes are checked above: cannot happen
-        raise DynamicsInputError(f'regressor kernel refused its input '
-                                 f'(status {code})')
+    status = np.zeros(1, dtype=np.int64)
+    row = K.run_regressor_batch(model.packed, Q, QD, QDD, bool(drives), eps,
+                                ws, line, acc, out, status)
+    if row != -1:       # the row step has no failure: cannot happen
+        raise DynamicsInputError(f'regressor kernel refused row {row} '
+                                 f'(status {int(status[0])})')
     return out
 
 

@@ -274,7 +274,8 @@ def _run_every_kernel(mod, model, dtype):
     YY = np.zeros((3, n, 14 * n), f)
     assert mod.run_regressor_batch(P, Q, Q, Q, True, f(0.02), ws,
                                    np.zeros((n, 6), f),
-                                   np.zeros((10 * n, 6), f), YY) == -1
+                                   np.zeros((10 * n, 6), f), YY,
+                                   status) == -1
     assert mod.mass_matrix_columns(links, frames, q, ws, scratch, M) == -1
     D = M.copy()
     assert mod.mass_matrix_crba(links, frames, q, ws, M) == -1

@@ -40,7 +40,7 @@ batch(<term>_row)``).  The row step's argument names say what each is
 strict entry and public function in ``core/dynamics.py``, its batch
 function in ``core/batch.py``.
 """
-from ._jit import ENTRY, njit
+from ._jit import njit
 from .aba import articulated_body
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
@@ -150,36 +150,12 @@ def link_poses_row(links, frames, q, ws, Ts):
     return matrix_status(Ts)
 
 
-# the regressor has a batch form only, and checks its own sizes (its
-# scratch comes from its caller, not from a Workspace)
-
-@njit(**ENTRY)
-def run_regressor_batch(P, Q, QD, QDD, drives, eps, ws, line, acc, Y):
-    """
-    Fill the torque regressor Y at each row (``regressor_columns``).
-
-    The caller checks the states (numpy, once per batch); this checks the
-    scratch and ``Y`` sizes only: -1, or ``SIZE + 5`` (scratch) or
-    ``SIZE + 4`` (Y).  With ``drives`` the 4n drive columns follow.
-    """
-    links, frames = _split(P)
-    n = links.shape[0]
-    m = Q.shape[0]
-    if (QD.shape[0] != m or QDD.shape[0] != m or Q.shape[1] != n
-            or QD.shape[1] != n or QDD.shape[1] != n):
-        return SIZE
-    if (ws.shape[0] < n or ws.shape[1] != W_WIDTH or line.shape[0] < n
-            or line.shape[1] != 6 or acc.shape[0] < 10 * n
-            or acc.shape[1] != 6):
-        return SIZE + 5
-    if (Y.shape[0] != m or Y.shape[1] != n
-            or Y.shape[2] != (14 * n if drives else 10 * n)):
-        return SIZE + 4
-    for i in range(m):
-        regressor_columns(links, frames, Q[i], QD[i], QDD[i], ws, line, acc,
-                          Y[i])
-        if drives:
-            drive_columns(frames, QD[i], QDD[i], eps, Y[i])
+@njit(cache=True, inline='always')
+def regressor_row(links, frames, q, qd, qdd, drives, eps, ws, line, acc, Y):
+    """Y(q, qd, qdd): n x 10n, and with ``drives`` the 4n drive columns."""
+    regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y)
+    if drives:
+        drive_columns(frames, qd, qdd, eps, Y)
     return -1
 
 
@@ -201,3 +177,4 @@ run_forward_dynamics = entry(forward_dynamics_row)
 run_forward_dynamics_batch = batch(forward_dynamics_row)
 run_jacobian = entry(jacobian_row)
 run_link_poses = entry(link_poses_row)
+run_regressor_batch = batch(regressor_row)

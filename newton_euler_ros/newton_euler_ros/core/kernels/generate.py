@@ -54,10 +54,12 @@ SHAPES = {
     'cw': ('>=n + 1', 'CW_WIDTH'), 'scratch': ('3', '>=n'),
     'Ts': ('n + 2', '12'),
     'terms': ('3', 'n'),
+    'line': ('>=n', '6'), 'acc': ('>=10 * n', '6'),
+    'Y': ('n', '14 * n if drives else 10 * n'),
 }
 # input a of the status codes (``calling.INPUTS``, ``calling.FD_INPUTS``)
 INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3}
-WORKSPACES = ('ws', 'aw', 'cw', 'scratch', 'Ts')
+WORKSPACES = ('ws', 'aw', 'cw', 'scratch', 'Ts', 'line', 'acc')
 
 SOURCES = {}    # name -> the generated source of each entry point
 

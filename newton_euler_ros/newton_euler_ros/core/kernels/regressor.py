@@ -20,8 +20,9 @@ give its 6 x 10 block (the wrench each inertial parameter causes), which
 the one force carry (``force_to_parent``) takes to frame 0; each joint
 then takes the moment about (revolute) or the force along (prismatic) its
 axis of the links it carries.  The drive columns (viscous, Coulomb,
-offset, armature) follow the 10n inertial ones when asked for.  Python
-calls ``entry.run_regressor_batch``; ``core.regressor`` is the API.
+offset, armature) follow the 10n inertial ones when asked for.  Its row
+step is ``entry.regressor_row``, its batch loop ``run_regressor_batch``
+is written from it (``generate.batch``); ``core.regressor`` is the API.
 """
 import math
 
