@@ -37,7 +37,6 @@ Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
 import dataclasses
-import functools
 import sys
 import threading
 import time
@@ -47,19 +46,17 @@ from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Bool, Float64MultiArray, String
+from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
-                     declare_parameters, plain, qos_profile, release_memory,
-                     run_node)
+                     declare_parameters, plain, qos_profile, QUIET,
+                     release_memory, run_node)
+from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
-from ..core import observer as momentum
-from ..core.effects import friction_torque
 from ..core.robot_file import Note
 from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
@@ -80,15 +77,6 @@ COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-# The node's publishers are created without rclpy's default QoS-event
-# handlers (incompatible QoS or type): each publisher's handlers join the
-# wait set that the executor rebuilds at every spin, which at 1 kHz
-# measured more than the dynamics (the observer's three publishers took
-# the node from 67 % to 95 % of a core).  A subscriber with an
-# incompatible QoS still says so on its side; the node's subscriptions
-# keep theirs.
-QUIET = PublisherEventCallbacks(use_default_callbacks=False)
 
 
 def _seconds(stamp):
@@ -191,7 +179,9 @@ class InverseDynamicsNode(Node):
         self._torques = JointState()
         if self.ff is not None:
             self._log_model(self.ff, self.model_source)
-        self._setup_observer()
+        self._observer = None
+        if self.params['observer.enabled']:
+            self._observer = NodeObserver(self, self.params, self.ff)
 
     def _make_computer(self, model, scene=None, previous=None,
                        payload=None):
@@ -244,7 +234,7 @@ class InverseDynamicsNode(Node):
             f'{model.name} ({source}): {model.n} joints '
             f'[{", ".join(ff.output_names)}], mode {self.mode}, effects '
             f'{effects}, payload {self.payload[0]} kg, wrench frames '
-            f'{_clip(str(sorted(ff.wrench.frames)))}'
+            f'{clip(str(sorted(ff.wrench.frames)), 400)}'
             + ('' if not self.params['drives.compensate'] else
                ', drive terms compensated' if ff.drives is not None else
                ', drives.compensate is on but the robot has no drive '
@@ -270,13 +260,13 @@ class InverseDynamicsNode(Node):
             keep = ('the previous model keeps working' if self.ff is not None
                     else 'still no model: publishing nothing')
             self.get_logger().error(
-                f'robot_description rejected: {_clip(str(exc))}; {keep}')
+                f'robot_description rejected: {clip(str(exc), 400)}; {keep}')
             return
         except Exception as exc:  # never let a description kill the node
             self.counts['descriptions_rejected'] += 1
             self.get_logger().error(
                 f'robot_description rejected (internal error): '
-                f'{_clip(str(exc))}')
+                f'{clip(str(exc), 400)}')
             return
         with self._description_lock:
             if seq != self._description_seq:
@@ -284,7 +274,7 @@ class InverseDynamicsNode(Node):
             for message in found:
                 log = (self.get_logger().debug if isinstance(message, Note)
                        else self.get_logger().warning)
-                log(_clip(message))
+                log(clip(message, 400))
             self.ff = ff        # one reference swap: callbacks see either
             self.counts['descriptions_loaded'] += 1
             self.model_source = (f'robot_description, {report["base"]} -> '
@@ -400,7 +390,7 @@ class InverseDynamicsNode(Node):
         self.torque_pub.publish(self._torques)
         self.counts['published'] += 1
         if self._observer is not None:
-            self._observe(ff, msg)
+            self._observer.observe(ff, msg, self._reject)
 
     def _over_limit(self, ff, what):
         self.counts['over_limit'] += 1
@@ -542,213 +532,17 @@ class InverseDynamicsNode(Node):
             KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
             KeyValue(key='payload.inertia',
                      value=repr(list(self.payload[2]))),
-            KeyValue(key='source', value=_clip(self.model_source)),
+            KeyValue(key='source', value=clip(self.model_source, 400)),
             KeyValue(key='limits.action', value=self.params['limits.action']),
             KeyValue(key='torque_bounds', value=repr(
                 ff.guard.bounds.tolist() if ff is not None else [])),
             KeyValue(key='torque_bound_sources', value=repr(
                 ff.bound_sources if ff is not None else []))]
         msg = DiagnosticArray(status=[status, model]
-                              + self._observer_diagnostics())
+                              + ([] if self._observer is None
+                                 else [self._observer.diagnostics()]))
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
-
-    # ---- momentum observer (observer.*): external torque and contact ----
-    def _setup_observer(self):
-        """Create the publishers and the contact timer (observer.enabled)."""
-        self._observer = None
-        if not self.params['observer.enabled']:
-            return
-        p = self.params
-        qos = qos_profile(p['qos.depth'], p['qos.reliability'])
-        self._observer = {
-            'ff': None, 'obs': None, 'state': None, 'contact': None,
-            'status': 'waiting for the first JointState',
-            'said': set(), 'rejected': 0, 'restarts': 0}
-        self.ext_torque_pub = self.create_publisher(
-            JointState, '~/external_torque', qos, event_callbacks=QUIET)
-        self.ext_wrench_pub = self.create_publisher(
-            WrenchStamped, '~/external_wrench', qos, event_callbacks=QUIET)
-        self.contact_pub = self.create_publisher(Bool, '~/contact', qos,
-                                                 event_callbacks=QUIET)
-        self._ext_torque = JointState()
-        self._ext_wrench = WrenchStamped()
-        self._wrench_out = np.zeros(6)
-        self.create_timer(p['observer.contact_period'],
-                          self._publish_contact)
-        if self.ff is not None:         # a bad setting fails at start-up
-            try:
-                self._observer_for(self.ff)
-            except ValueError as exc:
-                raise ConfigurationError(str(exc)) from None
-
-    def _observer_for(self, ff):
-        """
-        Return the observer of this computer's model (payload included).
-
-        Built again when the model changes (a new description or
-        payload): the residual and the contact carry over, and the
-        integral restarts at the next sample.
-        """
-        o = self._observer
-        if o['ff'] is ff:
-            return o['obs']
-        p = self.params
-        model = ff.model
-        scene = ff.scene
-        # the model's own drives (an identified URDF), or the scene's
-        drive, armature = momentum.drive_terms(model)
-        if scene is not None and scene.effects.friction:
-            drive = functools.partial(_scene_friction, scene)
-        if scene is not None and scene.effects.armature:
-            armature = scene.armature
-        obs = momentum.MomentumObserver(
-            model, p['observer.gain'], max_gap=p['observer.max_gap'],
-            drive_torque=drive, armature=armature,
-            damping=p['observer.damping'],
-            thresholds=_observer_values('observer.thresholds',
-                                        p['observer.thresholds'], model),
-            hysteresis=_at_most_one(p['observer.hysteresis']))
-        obs.warm_up()
-        old = o['state']
-        state = momentum.initial_state(obs)
-        if old is not None and old.r.shape == state.r.shape:
-            state.r[:] = old.r
-            state.restarts = old.restarts
-        if o['contact'] is None or o['contact'].active.shape != (model.n,):
-            o['contact'] = momentum.initial_contact(obs)
-        urdf = model.info.get('urdf') if isinstance(model.info, dict) \
-            else None
-        base = (p['base_link'] or (urdf or {}).get('base')
-                or (list(p['wrench.base_frames']) or ['base_link'])[0])
-        self._ext_wrench.header.frame_id = base
-        self._ext_torque.name = list(model.joint_names)
-        o.update(ff=ff, obs=obs, state=state)
-        return obs
-
-    def _observer_says(self, key, status, text):
-        """Set the observer's status; log ``text`` once per kind."""
-        o = self._observer
-        o['status'] = status
-        if key not in o['said']:
-            o['said'].add(key)
-            self.get_logger().warning(f'observer: {text}')
-
-    def _observe(self, ff, msg):
-        """Residual, wrench and contact for one JointState; publish."""
-        o = self._observer
-        try:
-            effort = ff.order.gather(msg.name, 'effort', msg.effort,
-                                     required=False)
-            if effort is None:
-                self._observer_says(
-                    'effort', 'cannot run: JointStates have no effort',
-                    'joint_states carry no effort: the observer cannot run '
-                    '(torques go on)')
-                return
-            if len(msg.velocity) == 0:
-                self._observer_says(
-                    'velocity', 'cannot run: JointStates have no velocity',
-                    'joint_states carry no velocity: the observer cannot '
-                    'run (torques go on)')
-                return
-            obs = self._observer_for(ff)
-            stamp = _seconds(msg.header.stamp) or self._now()
-            state = o['state']
-            r, what = momentum.observer_step(obs, state, stamp, ff.last_q,
-                                             ff.last_qd, effort)
-            if what == momentum.DUPLICATE:
-                return
-            F = momentum.external_wrench(obs, ff.last_q, r,
-                                         out=self._wrench_out)
-            contact = o['contact']
-            before = contact.in_contact
-            now = momentum.contact_step(obs, contact, r)
-            o['status'] = 'running'
-        except (InputRejected, NewtonEulerError, ValueError) as exc:
-            o['rejected'] += 1
-            self._observer_says('rejected', f'sample rejected: '
-                                f'{_clip(str(exc), 200)}',
-                                f'sample rejected ({_clip(str(exc), 200)})'
-                                f'; rejections are counted in '
-                                f'/diagnostics')
-            return
-        except Exception as exc:  # never let the observer kill the node
-            self._reject('observer', exc)
-            return
-        t = self._ext_torque
-        t.header.stamp = msg.header.stamp
-        t.effort = r.tolist()
-        self.ext_torque_pub.publish(t)
-        w = self._ext_wrench
-        w.header.stamp = msg.header.stamp
-        f, m = w.wrench.force, w.wrench.torque
-        f.x, f.y, f.z, m.x, m.y, m.z = F.tolist()
-        self.ext_wrench_pub.publish(w)
-        if now != before:
-            self.contact_pub.publish(Bool(data=now))
-            if now:
-                self.get_logger().info(
-                    f'observer: contact (number {contact.count}), external '
-                    f'torque {[round(x, 2) for x in r.tolist()]}')
-
-    def _publish_contact(self):
-        """Publish ~/contact at the steady rate."""
-        contact = self._observer['contact']
-        self.contact_pub.publish(
-            Bool(data=bool(contact is not None and contact.in_contact)))
-
-    def _observer_diagnostics(self):
-        """Return the observer's DiagnosticStatus (none when it is off)."""
-        o = self._observer
-        if o is None:
-            return []
-        contact, state = o['contact'], o['state']
-        running = o['status'] == 'running'
-        in_contact = bool(contact is not None and contact.in_contact)
-        status = DiagnosticStatus(
-            level=DiagnosticStatus.OK if running else DiagnosticStatus.WARN,
-            name=self.get_fully_qualified_name() + ': observer',
-            message=('contact' if in_contact else 'no contact')
-            if running else o['status'])
-        status.values = [
-            KeyValue(key='state', value=o['status']),
-            KeyValue(key='in_contact', value=str(in_contact).lower()),
-            KeyValue(key='contacts', value=str(
-                contact.count if contact is not None else 0)),
-            KeyValue(key='samples', value=str(
-                state.samples if state is not None else 0)),
-            KeyValue(key='restarts', value=str(
-                state.restarts if state is not None else 0)),
-            KeyValue(key='rejected', value=str(o['rejected'])),
-            KeyValue(key='gain', value=repr(self.params['observer.gain'])),
-            KeyValue(key='thresholds', value=repr(
-                list(self.params['observer.thresholds'])))]
-        return [status]
-
-
-def _observer_values(name, values, model):
-    """One value per joint (chain order) from a list of 1 or n values."""
-    values = list(values)
-    if len(values) not in (1, model.n):
-        raise ValueError(f'{name}: must have 1 or {model.n} values (one '
-                         f'per joint, chain order '
-                         f'{list(model.joint_names)}), got {len(values)}')
-    return values
-
-
-def _scene_friction(scene, qd, _qdd=None):
-    return friction_torque(scene, qd)
-
-
-def _at_most_one(value):
-    if not value <= 1.0:
-        raise ValueError(f'observer.hysteresis: must be <= 1, got {value!r}')
-    return value
-
-
-def _clip(text, limit=400):
-    return text if len(text) <= limit else text[:limit] + '...'
 
 
 def main(args=None):

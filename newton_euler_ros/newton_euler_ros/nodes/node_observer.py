@@ -1,0 +1,246 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+inverse_dynamics_node's momentum observer (``observer.*`` parameters).
+
+The ROS side of ``core.observer``: after the torques of a JointState are
+published, :meth:`NodeObserver.observe` runs one observer step on it and
+publishes ``~/external_torque`` (JointState, effort field),
+``~/external_wrench`` (WrenchStamped, base frame) and, on every change,
+``~/contact`` (Bool; also at ``observer.contact_period``).  Its state and
+counters go to ``/diagnostics`` (:meth:`NodeObserver.diagnostics`).  It
+never raises into the node: a sample it cannot use is counted and
+skipped, and JointStates without effort or velocity are reported once.
+"""
+import functools
+
+from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+from geometry_msgs.msg import WrenchStamped
+import numpy as np
+from sensor_msgs.msg import JointState
+from std_msgs.msg import Bool
+
+from .common import ConfigurationError, qos_profile, QUIET
+from ..core import NewtonEulerError
+from ..core import observer as momentum
+from ..core.effects import friction_torque
+from ..core.text import clip
+from ..feedforward import InputRejected
+
+
+def _seconds(stamp):
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
+class NodeObserver:
+    """The observer of one node: publishers, running state, diagnostics."""
+
+    def __init__(self, node, params, ff=None):
+        """
+        Create the publishers and the contact timer on ``node``.
+
+        ``params`` are the node's checked parameters; with a computer
+        ``ff`` already, a bad observer setting fails here (start-up).
+        """
+        self.node, self.params = node, params
+        self.ff = self.obs = self.state = self.contact = None
+        self.status = 'waiting for the first JointState'
+        self.said = set()
+        self.rejected = 0
+        qos = qos_profile(params['qos.depth'], params['qos.reliability'])
+        self.torque_pub = node.create_publisher(
+            JointState, '~/external_torque', qos, event_callbacks=QUIET)
+        self.wrench_pub = node.create_publisher(
+            WrenchStamped, '~/external_wrench', qos, event_callbacks=QUIET)
+        self.contact_pub = node.create_publisher(Bool, '~/contact', qos,
+                                                 event_callbacks=QUIET)
+        self._torque = JointState()
+        self._wrench = WrenchStamped()
+        self._wrench_out = np.zeros(6)
+        node.create_timer(params['observer.contact_period'],
+                          self.publish_contact)
+        if ff is not None:
+            try:
+                self.observer_for(ff)
+            except ValueError as exc:
+                raise ConfigurationError(str(exc)) from None
+
+    def observer_for(self, ff):
+        """
+        Return the observer of this computer's model (payload included).
+
+        Built again when the model changes (a new description or
+        payload): the residual and the contact carry over, and the
+        integral restarts at the next sample.
+        """
+        if self.ff is ff:
+            return self.obs
+        p = self.params
+        model = ff.model
+        scene = ff.scene
+        # the model's own drives (an identified URDF), or the scene's
+        drive, armature = momentum.drive_terms(model)
+        if scene is not None and scene.effects.friction:
+            drive = functools.partial(_scene_friction, scene)
+        if scene is not None and scene.effects.armature:
+            armature = scene.armature
+        obs = momentum.MomentumObserver(
+            model, p['observer.gain'], max_gap=p['observer.max_gap'],
+            drive_torque=drive, armature=armature,
+            damping=p['observer.damping'],
+            thresholds=_per_joint('observer.thresholds',
+                                  p['observer.thresholds'], model),
+            hysteresis=_at_most_one(p['observer.hysteresis']))
+        obs.warm_up()
+        old = self.state
+        state = momentum.initial_state(obs)
+        if old is not None and old.r.shape == state.r.shape:
+            state.r[:] = old.r
+            state.restarts = old.restarts
+        if self.contact is None or self.contact.active.shape != (model.n,):
+            self.contact = momentum.initial_contact(obs)
+        urdf = model.info.get('urdf') if isinstance(model.info, dict) \
+            else None
+        base = (p['base_link'] or (urdf or {}).get('base')
+                or (list(p['wrench.base_frames']) or ['base_link'])[0])
+        self._wrench.header.frame_id = base
+        self._torque.name = list(model.joint_names)
+        self.ff, self.obs, self.state = ff, obs, state
+        return obs
+
+    def _says(self, key, status, text):
+        """Set the observer's status; log ``text`` once per kind."""
+        self.status = status
+        if key not in self.said:
+            self.said.add(key)
+            self.node.get_logger().warning(f'observer: {text}')
+
+    def _step(self, ff, msg):
+        """Return (residual, wrench, contact before, after) or None."""
+        effort = ff.order.gather(msg.name, 'effort', msg.effort,
+                                 required=False)
+        if effort is None:
+            self._says('effort', 'cannot run: JointStates have no effort',
+                       'joint_states carry no effort: the observer cannot '
+                       'run (torques go on)')
+            return None
+        if len(msg.velocity) == 0:
+            self._says('velocity',
+                       'cannot run: JointStates have no velocity',
+                       'joint_states carry no velocity: the observer cannot '
+                       'run (torques go on)')
+            return None
+        obs = self.observer_for(ff)
+        stamp = _seconds(msg.header.stamp) or \
+            self.node.get_clock().now().nanoseconds * 1e-9
+        r, what = momentum.observer_step(obs, self.state, stamp, ff.last_q,
+                                         ff.last_qd, effort)
+        if what == momentum.DUPLICATE:
+            return None
+        F = momentum.external_wrench(obs, ff.last_q, r, out=self._wrench_out)
+        before = self.contact.in_contact
+        now = momentum.contact_step(obs, self.contact, r)
+        self.status = 'running'
+        return r, F, before, now
+
+    def observe(self, ff, msg, reject):
+        """
+        Residual, wrench and contact for one JointState; publish them.
+
+        ``ff`` has just computed the torques of ``msg`` (its ``last_q``,
+        ``last_qd``); ``reject(source, exc)`` is the node's report of an
+        unexpected failure.
+        """
+        try:
+            step = self._step(ff, msg)
+        except (InputRejected, NewtonEulerError, ValueError) as exc:
+            self.rejected += 1
+            why = clip(str(exc), 200)
+            self._says('rejected', f'sample rejected: {why}',
+                       f'sample rejected ({why}); rejections are counted in '
+                       f'/diagnostics')
+            return
+        except Exception as exc:  # never let the observer kill the node
+            reject('observer', exc)
+            return
+        if step is None:
+            return
+        r, F, before, now = step
+        t = self._torque
+        t.header.stamp = msg.header.stamp
+        t.effort = r.tolist()
+        self.torque_pub.publish(t)
+        w = self._wrench
+        w.header.stamp = msg.header.stamp
+        f, m = w.wrench.force, w.wrench.torque
+        f.x, f.y, f.z, m.x, m.y, m.z = F.tolist()
+        self.wrench_pub.publish(w)
+        if now != before:
+            self.contact_pub.publish(Bool(data=now))
+            if now:
+                self.node.get_logger().info(
+                    f'observer: contact (number {self.contact.count}), '
+                    f'external torque {[round(x, 2) for x in r.tolist()]}')
+
+    def publish_contact(self):
+        """Publish ~/contact at the steady rate."""
+        contact = self.contact
+        self.contact_pub.publish(
+            Bool(data=bool(contact is not None and contact.in_contact)))
+
+    def diagnostics(self):
+        """Return the observer's DiagnosticStatus."""
+        contact, state = self.contact, self.state
+        running = self.status == 'running'
+        in_contact = bool(contact is not None and contact.in_contact)
+        status = DiagnosticStatus(
+            level=DiagnosticStatus.OK if running else DiagnosticStatus.WARN,
+            name=self.node.get_fully_qualified_name() + ': observer',
+            message=('contact' if in_contact else 'no contact')
+            if running else self.status)
+        status.values = [
+            KeyValue(key='state', value=self.status),
+            KeyValue(key='in_contact', value=str(in_contact).lower()),
+            KeyValue(key='contacts', value=str(
+                contact.count if contact is not None else 0)),
+            KeyValue(key='samples', value=str(
+                state.samples if state is not None else 0)),
+            KeyValue(key='restarts', value=str(
+                state.restarts if state is not None else 0)),
+            KeyValue(key='rejected', value=str(self.rejected)),
+            KeyValue(key='gain', value=repr(self.params['observer.gain'])),
+            KeyValue(key='thresholds', value=repr(
+                list(self.params['observer.thresholds'])))]
+        return status
+
+
+def _per_joint(name, values, model):
+    """One value per joint (chain order) from a list of 1 or n values."""
+    values = list(values)
+    if len(values) not in (1, model.n):
+        raise ValueError(f'{name}: must have 1 or {model.n} values (one '
+                         f'per joint, chain order '
+                         f'{list(model.joint_names)}), got {len(values)}')
+    return values
+
+
+def _scene_friction(scene, qd, _qdd=None):
+    return friction_torque(scene, qd)
+
+
+def _at_most_one(value):
+    if not value <= 1.0:
+        raise ValueError(f'observer.hysteresis: must be <= 1, got {value!r}')
+    return value
