@@ -190,111 +190,143 @@ def run_phase(key, label, domain, cmd, sub_topic, args, logs_dir, env=None):
     n_slots = int(round(args.duration * args.rate))
     walk = random_walk(n_slots, args.rate, args.seed, args.limits,
                        args.model)
-    extra = ()
-    if key == 'observer':
-        from geometry_msgs.msg import WrenchStamped
-        from std_msgs.msg import Bool
-        extra = ((WRENCH_TOPIC, WrenchStamped), (CONTACT_TOPIC, Bool))
     clock = _StampClock()
-    child = None
-    bench = None
+    child = bench = None
     try:
         if cmd:
             child = ChildProcess(cmd, domain,
                                  os.path.join(logs_dir, f'{key}.log'),
                                  env=env, die_with_parent=True)
             result['log'] = child.log_path
-        command_topic = (sub_topic.rsplit('/', 1)[0] + '/torque_command'
-                         if cmd and args.also_command else None)
-        bench = BenchSide(domain, LOOP_TOPIC if cmd is None else
-                          INPUT_TOPIC, sub_topic, args.bench_executor,
-                          command_topic, extra=extra)
+        bench, command_topic = _bench_side(key, domain, cmd, sub_topic,
+                                           args)
         result['bench_executor'] = bench.executor_name
-        waited, answer, sent = wait_ready(
-            bench, child, args.startup_timeout, clock, walk)
-        problems = check_answer(answer, sent, key)
-        result['startup_s'] = waited
-        result['answer_problems'] = problems
-        log(f'ready after {waited:.2f} s (matched, warm-up answered'
-            + (f'; PROBLEMS: {"; ".join(problems)}' if problems else
-               ', answer well-formed') + ')')
-        foreign = (bench.pub.get_subscription_count() > 1
-                   or bench.sub.get_publisher_count() > 1)
-        result['foreign_endpoints'] = foreign
-        if foreign:
-            log('WARNING: other participants in this domain also use these '
-                'topics; choose another --domain')
-        if args.preroll > 0:
-            paced_send(bench, int(args.preroll * args.rate), args.rate,
-                       clock, walk, args.spin_us * 1e-6, record=False)
-        commands0 = len(bench.commands)
-        extra0 = {t: len(box) for t, box in bench.extra.items()}
-        cpu0 = _cpu_seconds(child.pid) if child else None
-        own0 = time.process_time()
-        t0 = time.monotonic()
-        old_switch = sys.getswitchinterval()
-        sys.setswitchinterval(args.switch_us * 1e-6)
-        gc_was_enabled = gc.isenabled()
-        if not args.keep_gc:
-            gc.disable()   # no collector pauses in the bench while timing
-        try:
-            send = paced_send(bench, n_slots, args.rate, clock, walk,
-                              args.spin_us * 1e-6)
-            wall = time.monotonic() - t0
-            cpu1 = _cpu_seconds(child.pid) if child else None
-            own1 = time.process_time()
-            # drain: until every answer is in, or --drain s
-            end = time.monotonic() + args.drain
-            want = set(send['stamps'])
-            wrenches = bench.extra.get(WRENCH_TOPIC)
-            while time.monotonic() < end:
-                got = sum(1 for _, raw in bench.received
-                          if raw_stamp_ns(raw) in want)
-                if wrenches is not None:    # and every wrench
-                    got = min(got, sum(1 for _, raw in wrenches
-                                       if raw_stamp_ns(raw) in want))
-                if got >= len(want):
-                    break
-                time.sleep(0.02)
-            received = list(bench.received)
-            commands = len(bench.commands) - commands0
-            extras = {t: list(box[extra0[t]:])
-                      for t, box in bench.extra.items()}
-        finally:
-            sys.setswitchinterval(old_switch)
-            if gc_was_enabled:
-                gc.enable()
+        _get_ready(key, bench, child, args, clock, walk, result)
+        timed = _timed(bench, child, args, clock, walk, n_slots)
         if bench.spin_errors:
             raise BenchError(f'receive thread failed: {bench.spin_errors}')
     finally:
-        try:
-            if bench is not None:
-                bench.close()
-        finally:
-            if child is not None:
-                child.stop(args.stop_timeout)
-                log(f'stopped {label}: exit code {child.exit_code} '
-                    f'({child.stop_how}); log {child.log_path}')
-    stats, lat_us = summarize(send, received, args.rate)
+        _stop(label, bench, child, args)
+    return _phase_result(key, result, timed, child, args, command_topic)
+
+
+def _bench_side(key, domain, cmd, sub_topic, args):
+    """Return the bench's node of this phase and its command topic."""
+    extra = ()
+    if key == 'observer':
+        from geometry_msgs.msg import WrenchStamped
+        from std_msgs.msg import Bool
+        extra = ((WRENCH_TOPIC, WrenchStamped), (CONTACT_TOPIC, Bool))
+    command_topic = (sub_topic.rsplit('/', 1)[0] + '/torque_command'
+                     if cmd and args.also_command else None)
+    bench = BenchSide(domain, LOOP_TOPIC if cmd is None else INPUT_TOPIC,
+                      sub_topic, args.bench_executor, command_topic,
+                      extra=extra)
+    return bench, command_topic
+
+
+def _get_ready(key, bench, child, args, clock, walk, result):
+    """Wait for the peer's first well-formed answer, then pre-roll."""
+    waited, answer, sent = wait_ready(bench, child, args.startup_timeout,
+                                      clock, walk)
+    problems = check_answer(answer, sent, key)
+    result['startup_s'] = waited
+    result['answer_problems'] = problems
+    log(f'ready after {waited:.2f} s (matched, warm-up answered'
+        + (f'; PROBLEMS: {"; ".join(problems)}' if problems else
+           ', answer well-formed') + ')')
+    foreign = (bench.pub.get_subscription_count() > 1
+               or bench.sub.get_publisher_count() > 1)
+    result['foreign_endpoints'] = foreign
+    if foreign:
+        log('WARNING: other participants in this domain also use these '
+            'topics; choose another --domain')
+    if args.preroll > 0:
+        paced_send(bench, int(args.preroll * args.rate), args.rate, clock,
+                   walk, args.spin_us * 1e-6, record=False)
+
+
+def _drain(bench, stamps, seconds):
+    """Wait until every answer (and observer wrench) is in, or seconds."""
+    end = time.monotonic() + seconds
+    want = set(stamps)
+    wrenches = bench.extra.get(WRENCH_TOPIC)
+    while time.monotonic() < end:
+        got = sum(1 for _, raw in bench.received if raw_stamp_ns(raw) in want)
+        if wrenches is not None:
+            got = min(got, sum(1 for _, raw in wrenches
+                               if raw_stamp_ns(raw) in want))
+        if got >= len(want):
+            return
+        time.sleep(0.02)
+
+
+def _timed(bench, child, args, clock, walk, n_slots):
+    """Send n_slots paced states, drain; return what was measured."""
+    commands0 = len(bench.commands)
+    extra0 = {t: len(box) for t, box in bench.extra.items()}
+    t = {'cpu0': _cpu_seconds(child.pid) if child else None,
+         'own0': time.process_time()}
+    t0 = time.monotonic()
+    old_switch = sys.getswitchinterval()
+    sys.setswitchinterval(args.switch_us * 1e-6)
+    gc_was_enabled = gc.isenabled()
+    if not args.keep_gc:
+        gc.disable()   # no collector pauses in the bench while timing
+    try:
+        t['send'] = paced_send(bench, n_slots, args.rate, clock, walk,
+                               args.spin_us * 1e-6)
+        t['wall'] = time.monotonic() - t0
+        t['cpu1'] = _cpu_seconds(child.pid) if child else None
+        t['own1'] = time.process_time()
+        _drain(bench, t['send']['stamps'], args.drain)
+        t['received'] = list(bench.received)
+        t['commands'] = len(bench.commands) - commands0
+        t['extras'] = {k: list(box[extra0[k]:])
+                       for k, box in bench.extra.items()}
+    finally:
+        sys.setswitchinterval(old_switch)
+        if gc_was_enabled:
+            gc.enable()
+    return t
+
+
+def _stop(label, bench, child, args):
+    """Close the bench's node, then stop the peer."""
+    try:
+        if bench is not None:
+            bench.close()
+    finally:
+        if child is not None:
+            child.stop(args.stop_timeout)
+            log(f'stopped {label}: exit code {child.exit_code} '
+                f'({child.stop_how}); log {child.log_path}')
+
+
+def _phase_result(key, result, t, child, args, command_topic):
+    """Return (the phase's figures, its latencies in us)."""
+    stats, lat_us = summarize(t['send'], t['received'], args.rate)
     result.update(stats)
     if command_topic:
         # not matched by stamp (Float64MultiArray has none): a count of
         # what arrived from the timed start to the end of the drain
-        result['torque_command_received'] = commands
+        result['torque_command_received'] = t['commands']
+    wall = t['wall']
     if child is not None:
         result['exit_code'] = child.exit_code
         result['stopped_by'] = child.stop_how
-        result['node_cpu_percent'] = (100.0 * (cpu1 - cpu0) / wall
-                                      if cpu0 is not None and cpu1 is not None
-                                      else None)
-    result['bench_cpu_percent'] = 100.0 * (own1 - own0) / wall
+        result['node_cpu_percent'] = (
+            100.0 * (t['cpu1'] - t['cpu0']) / wall
+            if t['cpu0'] is not None and t['cpu1'] is not None else None)
+    result['bench_cpu_percent'] = 100.0 * (t['own1'] - t['own0']) / wall
     result['load_average_end'] = _loadavg()
     L = stats['latency_us']
     log(f'latency us: p50 {L["p50"]:.0f}  p99 {L["p99"]:.0f}  p99.9 '
         f'{L["p99.9"]:.0f}  max {L["max"]:.0f};  sent {stats["sent"]}  '
         f'received {stats["received"]}  dropped {stats["dropped"]}')
     if key == 'observer':
-        result['observer'] = observer_check(send, received, extras)
+        result['observer'] = observer_check(t['send'], t['received'],
+                                            t['extras'])
     return result, lat_us
 
 
