@@ -24,7 +24,8 @@ remapped onto robot_sim_node's ``~/joint_trajectory``, where the
 simulator stands in for joint_trajectory_controller with an effort
 command interface (PD + the points' effort).  Two segments: approach,
 then, after the arm picks up a 3 kg object (the plant's payload is set
-through robot_sim_node's parameter service at the pick time), carry.
+through robot_sim_node's parameter service, ``payload.at`` the pick
+time), carry.
 
 Run twice, each in a domain of its own: once telling the feedforward
 node about the payload before the carry segment is planned
@@ -43,7 +44,7 @@ from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
 from .demo import (base_domain, check_exits, Child, DemoError, Recorder,
-                   stop_children, wait_for)
+                   STARTUP_TIMEOUT, stop_children, wait_for)
 
 SCENE = 'puma_pick_and_place'
 # 3 kg held at the flange origin, the Puma's wrist centre: a load on the
@@ -107,6 +108,7 @@ class PickRecorder(Recorder):
         super().__init__(domain)
         from trajectory_msgs.msg import JointTrajectory
         self.filled = []
+        self.clients = {}
         # the node's ~/trajectory_out is remapped onto the simulator's input
         self.node.create_subscription(JointTrajectory,
                                       f'{SIM}/joint_trajectory',
@@ -114,18 +116,23 @@ class PickRecorder(Recorder):
         self.plan = self.node.create_publisher(JointTrajectory,
                                                f'{ID}/trajectory_in', 10)
 
-    def set_payload(self, node, payload):
-        """Set payload.* on ``node`` in one atomic change."""
+    def _client(self, node):
         from rcl_interfaces.srv import SetParametersAtomically
-        from rclpy.parameter import Parameter
-        client = self.node.create_client(
-            SetParametersAtomically, f'{node}/set_parameters_atomically')
-        if not client.wait_for_service(timeout_sec=10.0):
+        if node not in self.clients:
+            self.clients[node] = self.node.create_client(
+                SetParametersAtomically,
+                f'{node}/set_parameters_atomically')
+        return self.clients[node]
+
+    def call_parameters(self, node, params, limit=10.0, wait=10.0):
+        """Set ``params`` on ``node`` in one atomic change; return the result."""
+        from rcl_interfaces.srv import SetParametersAtomically
+        client = self._client(node)
+        if not client.wait_for_service(timeout_sec=wait):
             raise DemoError(f'{node}: no parameter service')
         request = SetParametersAtomically.Request(parameters=[
-            Parameter(f'payload.{k}', value=v).to_parameter_msg()
-            for k, v in payload.items()])
-        end = time.monotonic() + 10.0
+            p.to_parameter_msg() for p in params])
+        end = time.monotonic() + limit
         future = None
         while time.monotonic() < end:
             # a fresh client's first response can be lost in discovery
@@ -135,10 +142,30 @@ class PickRecorder(Recorder):
             while not future.done() and time.monotonic() < resend:
                 self.spin_once(0.01)
             if future.done():
-                break
+                return future.result().result
             client.remove_pending_request(future)
-        if not future.done() or not future.result().result.successful:
-            raise DemoError(f'{node}: setting the payload failed')
+        raise DemoError(f'{node}: no answer from its parameter service')
+
+    def warm_up(self, node):
+        """
+        Make one empty parameter call to ``node``, before the clock runs.
+
+        The call at the pick must then take a round trip, not a
+        discovery (a first response lost costs a 2 s resend, during
+        which the plant would carry the object the feedforward knows of,
+        or the reverse).
+        """
+        # a node's first start may compile its kernels
+        self.call_parameters(node, [], wait=STARTUP_TIMEOUT)
+
+    def set_payload(self, node, payload):
+        """Set payload.* on ``node`` in one atomic change."""
+        from rclpy.parameter import Parameter
+        result = self.call_parameters(node, [
+            Parameter(f'payload.{k}', value=v) for k, v in payload.items()])
+        if not result.successful:
+            raise DemoError(f'{node}: setting the payload failed: '
+                            f'{result.reason}')
 
 
 def run(label, update_feedforward, duration, domain, log_dir, model, q0):
@@ -156,12 +183,14 @@ def run(label, update_feedforward, duration, domain, log_dir, model, q0):
         wait_for(rec, children,
                  lambda: rec.subscribers(f'{SIM}/joint_trajectory') >= 1,
                  'robot_sim_node')
+        rec.warm_up(SIM)    # its clock waits for the node's subscription
         children.append(Child(
             f'{label}_inverse_dynamics_node',
             'newton_euler_ros.nodes.inverse_dynamics_node',
             ['-p', 'robot_file:=puma560', '-p', 'mode:=gravity',
              '-r', f'~/trajectory_out:={SIM}/joint_trajectory'],
             domain, log_dir))
+        rec.warm_up(ID)     # t = 0 is held for the approach
         wait_for(rec, children,
                  lambda: rec.plan.get_subscription_count() >= 1
                  and rec.publishers(f'{SIM}/joint_trajectory') >= 1
@@ -177,16 +206,15 @@ def run(label, update_feedforward, duration, domain, log_dir, model, q0):
                                             rec.t0 + CARRY, segments[1]))
         wait_for(rec, children, lambda: len(rec.filled) >= 2,
                  'the carry segment with efforts')
-        picked = False
+        # the object is in hand at t = PICK exactly, whatever the latency
+        # of this call (a late pick would count as a feedforward error)
+        rec.set_payload(SIM, dict(PAYLOAD, at=PICK))
         end = time.monotonic() + 60.0 + 10.0 * duration
         while True:
             rec.spin_once()
             for child in children:
                 child.check_alive()
             t = rec.last_time()
-            if t is not None and not picked and t >= PICK:
-                rec.set_payload(SIM, PAYLOAD)      # the object is in hand
-                picked = True
             if t is not None and t >= duration - 1e-9:
                 break
             if time.monotonic() > end:
@@ -296,7 +324,8 @@ def main(argv=None):
         f'into robot_sim_node standing in for joint_trajectory_controller '
         f"(PD + the points' effort, the scene's gains). At t = {PICK} s "
         f"the arm picks up {PAYLOAD['mass']} kg (the plant's payload is "
-        f'set through its parameter service), at its wrist centre; the carry '
+        f'set through its parameter service, with `payload.at` the pick '
+        f'time), at its wrist centre; the carry '
         f'segment, planned before the pick, holds {HOLD} s and then moves.',
         '',
         '| run | RMS error before the pick (rad) | RMS error while carrying '

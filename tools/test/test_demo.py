@@ -106,4 +106,10 @@ def test_quick_pick_and_place_demo(tmp_path):
     assert after['updated'] * 10 < after['stale']
     # 3 kg at the wrist centre needs its weight's torque, about m g r
     assert 5.0 < result['effort_added_max'] < 40.0
+    # the plant picks the object up at t = 2.2 s exactly in both runs
+    # (payload.at), whatever the parameter call's latency
+    for label in ('updated', 'stale'):
+        log = (out / 'logs' / f'{label}_robot_sim_node.log').read_text()
+        assert 'plant payload now 3.0 kg at [0.0, 0.0, 0.0] m, t = 2.200 s' \
+            in log, log
     assert os.path.getsize(out / 'tracking.png') > 0

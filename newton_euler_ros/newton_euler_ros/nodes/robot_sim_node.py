@@ -41,7 +41,8 @@ this node's timeline, ``start + t``; zero stamp: now) takes over from
 ``~/commands`` once it starts, commanding kp (q_d - q) + kd (qd_d - qd)
 + effort_d with the scene's gains at every control period.  The plant's
 payload (``payload.mass``, ``payload.com``, ``payload.inertia``) can be
-changed at run time: picking up an object.
+changed at run time: picking up an object, at once or at the simulated
+time ``payload.at``.
 
 Subscribes
     ~/commands (std_msgs/Float64MultiArray: n torques, the model's order),
@@ -125,6 +126,7 @@ class RobotSimNode(Node):
             self.dyn = self._plant(self.payload)
         except ValueError as exc:
             raise ConfigurationError(str(exc)) from None
+        self.pending = None     # (time, dynamics, payload) from payload.at
         self.follower = TrajectoryFollower(scene.model)
         self.commands = 0            # commands received on ~/commands
         self.over_limit = 0          # commands beyond the torque bounds
@@ -211,13 +213,13 @@ class RobotSimNode(Node):
         self.commanded = True
 
     def _ready(self):
-        if not self.wait:
+        if not self.wait and not self.subscribers:
             return True
         # matched publishers (this node's readers know them), not just
         # discovered ones
         controllers = (self.cmd_sub.get_publisher_count()
                        + self.traj_sub.get_publisher_count())
-        if (controllers < 1
+        if ((self.wait and controllers < 1)
                 or self.state_pub.get_subscription_count()
                 < self.subscribers):
             self.ready_since = None
@@ -267,6 +269,7 @@ class RobotSimNode(Node):
             self.ticks += 1
             t_next = self.ticks * self.period
             if t_next <= self.scene.duration + 1e-9:
+                self._take_pending_payload()
                 tau = self._trajectory_command()
                 self.q, self.qd = advance(self.dyn, self.q, self.qd, tau,
                                           self.t, self.period,
@@ -314,10 +317,24 @@ class RobotSimNode(Node):
             dyn = self._plant(payload)
         except (ValueError, TypeError) as exc:
             return SetParametersResult(successful=False, reason=str(exc))
-        self.dyn, self.payload = dyn, payload
-        self.get_logger().info(f'plant payload now {payload[0]} kg at '
-                               f'{list(payload[1])} m, t = {self.t:.3f} s')
+        at = values.get('payload.at', self.get_parameter('payload.at').value)
+        self.pending = (at, dyn, payload)
+        if at <= self.t + 1e-9:
+            self._take_pending_payload()
+        else:
+            self.get_logger().info(f'plant payload {payload[0]} kg from '
+                                   f't = {at:.3f} s')
         return SetParametersResult(successful=True)
+
+    def _take_pending_payload(self):
+        """Put a payload change on the plant once its time has come."""
+        if self.pending is None or self.pending[0] > self.t + 1e-9:
+            return
+        _, self.dyn, self.payload = self.pending
+        self.pending = None
+        self.get_logger().info(f'plant payload now {self.payload[0]} kg at '
+                               f'{list(self.payload[1])} m, t = '
+                               f'{self.t:.3f} s')
 
     def _on_trajectory(self, msg):
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9

@@ -45,6 +45,7 @@ import sys
 
 from builtin_interfaces.msg import Duration
 import numpy as np
+from rclpy.duration import Duration as Span
 from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -60,6 +61,7 @@ from ..sim.simulate import pd_torque
 
 SAMPLE = 0.01           # reference sampling period, seconds
 PENDING = 32            # joint states / feedforward kept for matching
+ACK_WAIT = 5.0          # seconds a stop waits for the last commands' acks
 REPUBLISH = 0.1         # seconds between checks to republish the reference
 
 
@@ -261,6 +263,13 @@ class TrackingControllerNode(Node):
 
     def destroy_node(self):
         """Log how many commands were sent, then destroy the node."""
+        # a command lost on its first delivery is sent again only while
+        # this publisher lives: wait (bounded) until every reliable
+        # subscriber has acknowledged the last one
+        if self.context.ok() and not self.cmd_pub.wait_for_all_acked(
+                Span(seconds=ACK_WAIT)):
+            self.get_logger().warning(
+                f'some commands were not acknowledged within {ACK_WAIT:g} s')
         self.get_logger().info(f'commands sent: {self.published}')
         return super().destroy_node()
 
