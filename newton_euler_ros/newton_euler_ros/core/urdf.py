@@ -369,18 +369,8 @@ def parse_urdf(text, label='robot_description'):
     return name, roots[0], links, joints
 
 
-def urdf_model(text, label='robot_description', base=None, tip=None,
-               gravity=(0.0, 0.0, -9.81)):
-    """
-    Build the chain model of URDF text; return (model, warnings, report).
-
-    ``report`` describes what was made of the tree: the chain's links and
-    joints, the merged fixed joints, the lumped subtrees and the frames
-    rigidly attached to the base and to the tip (for wrenches).
-    """
-    name, root, links, joints = parse_urdf(text, label)
-    found = []
-    base, tip, chain = chain_ends(label, links, joints, root, base, tip)
+def _moving_joints(label, joints, chain, base, tip):
+    """Return the chain's moving joints; a floating or planar one is an error."""
     for jname in chain:
         kind = joints[jname].kind
         if kind in ('floating', 'planar'):
@@ -392,12 +382,17 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     if not moving:
         raise RobotFileError(f'{label}: no revolute, continuous or prismatic'
                              f' joint between {base!r} and {tip!r}')
-    chain_set = set(chain)
-    chain_links = {base} | {joints[j].child for j in chain}
-    # ---- placements: fixed origins merged into the next moving joint ----
-    pre = []
-    merged = []
-    pending = []
+    return moving
+
+
+def _placements(joints, chain, moving):
+    """
+    Return (pre, merged, tool): each moving joint's placement ops.
+
+    A fixed joint's origin is merged into the next moving joint's; those
+    after the last moving joint make the tool transform.
+    """
+    pre, merged, pending = [], [], []
     for jname in chain:
         joint = joints[jname]
         if joint.kind == 'fixed':
@@ -409,36 +404,43 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     tool = np.eye(4)
     for jname in chain[chain.index(moving[-1]) + 1:]:
         tool = tool @ joints[jname].origin
-    # ---- the rigid body each moving joint carries ----
-    mass, com, inertia, carried = [], [], [], []
-    lumped = []
-    massless = []
-    for k, jname in enumerate(moving):
-        stop = {moving[k + 1]} if k + 1 < len(moving) else set()
-        parts = attached(links, joints, joints[jname].child, stop)
-        m, c, inertia_k = combine(parts, links)
-        mass.append(m)
-        com.append(c)
-        inertia.append(inertia_k)
-        carried.append(parts)
-        for lname, _, via in parts:
-            # a massless link on a fixed joint is a frame (tool0, ee_link,
-            # flange): nothing to warn about
-            if not links[lname].has_inertial and not (
-                    via is not None and joints[via].kind == 'fixed'):
-                massless.append(lname)
-            joint = joints[via] if via is not None else None
-            if joint is not None and via not in chain_set \
-                    and joint.parent in chain_links:
-                lumped.append((via, joint.kind))
-    # ---- frames rigidly attached to the tip and to the base ----
-    tip_frames = {}
+    return pre, merged, tool
+
+
+class _Bodies:
+    """The rigid body each moving joint carries, and what went into it."""
+
+    def __init__(self, links, joints, base, chain, moving):
+        self.mass, self.com, self.inertia, self.carried = [], [], [], []
+        self.lumped = []        # (joint, kind) of off-chain subtrees
+        self.massless = []      # links without <inertial>
+        chain_links = {base} | {joints[j].child for j in chain}
+        for k, jname in enumerate(moving):
+            stop = {moving[k + 1]} if k + 1 < len(moving) else set()
+            parts = attached(links, joints, joints[jname].child, stop)
+            m, c, inertia_k = combine(parts, links)
+            self.mass.append(m)
+            self.com.append(c)
+            self.inertia.append(inertia_k)
+            self.carried.append(parts)
+            for lname, _, via in parts:
+                joint = joints[via] if via is not None else None
+                # a massless link on a fixed joint is a frame (tool0,
+                # ee_link, flange): nothing to warn about
+                if not links[lname].has_inertial and not (
+                        joint is not None and joint.kind == 'fixed'):
+                    self.massless.append(lname)
+                if joint is not None and via not in chain \
+                        and joint.parent in chain_links:
+                    self.lumped.append((via, joint.kind))
+
+
+def _attached_frames(links, joints, base, moving, tip_parts, tool):
+    """Return (tip_frames, base_frames): frames rigid with tip and base."""
     tool_inv = np.linalg.inv(tool)
-    for lname, T, _ in carried[-1]:
-        tip_frames[lname] = tool_inv @ T
+    tip_frames = {lname: tool_inv @ T for lname, T, _ in tip_parts}
     base_frames = {}
-    first_stop = {moving[0]}
-    for lname, T, via in attached(links, joints, base, first_stop):
+    for lname, T, via in attached(links, joints, base, {moving[0]}):
         if via is None or joints[via].kind == 'fixed':
             base_frames[lname] = T
     # links above the base, when they are joined to it by fixed joints
@@ -450,44 +452,65 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         T = T @ np.linalg.inv(joint.origin)
         lname = joint.parent
         base_frames[lname] = T
-    # ---- warnings ----
+    return tip_frames, base_frames
+
+
+def _tree_warnings(label, links, joints, bodies):
+    """Return what the user should know of the tree: lumped, massless, odd."""
+    found = []
     # massless frames on fixed joints (ee_link, tool0) change nothing
-    told = [(v, kind) for v, kind in lumped if kind != 'fixed'
+    told = [(v, kind) for v, kind in bodies.lumped if kind != 'fixed'
             or links[joints[v].child].mass > 0.0
             or links[joints[v].child].inertia.any()]
     if told:
-        moved = [f'{v} ({kind})' for v, kind, *_ in told if kind != 'fixed']
+        moved = [f'{v} ({kind})' for v, kind in told if kind != 'fixed']
         found.append(
             f'{label}: off-chain subtrees lumped rigidly into the chain at '
             f'their zero position (their motion is not modelled): joints '
-            f'{_short(", ".join(v for v, *_ in told), 400)}'
+            f'{_short(", ".join(v for v, _ in told), 400)}'
             + (f'; moving ones locked: {_short(", ".join(moved), 300)}'
                if moved else ''))
-    if massless:
+    if bodies.massless:
         found.append(f'{label}: links without <inertial> are massless: '
-                     f'{_short(", ".join(sorted(set(massless))), 400)}')
-    for k, parts in enumerate(carried):
+                     f'{_short(", ".join(sorted(set(bodies.massless))), 400)}')
+    for parts in bodies.carried:
         for lname, _, _ in parts:
-            lk = links[lname]
-            if lk.has_inertial:
-                eig = lk.eig
+            if links[lname].has_inertial:
                 note = triangle_note(f'{label}: link {lname!r} <inertia>',
-                                     eig)
+                                     links[lname].eig)
                 if note:
                     found.append(note)
-    limits = []
-    for jname in moving:
-        lim = {}
-        for key, value in joints[jname].limits.items():
-            if key in ('velocity', 'effort') and not value > 0.0:
-                continue        # "0" is common for "not given"
-            lim[key] = value
-        limits.append(lim)
+    return found
+
+
+def _chain_limits(joints, moving):
+    """Each moving joint's limits; a velocity or effort of 0 is not given."""
+    return [{key: value for key, value in joints[j].limits.items()
+             if key not in ('velocity', 'effort') or value > 0.0}
+            for j in moving]
+
+
+def urdf_model(text, label='robot_description', base=None, tip=None,
+               gravity=(0.0, 0.0, -9.81)):
+    """
+    Build the chain model of URDF text; return (model, warnings, report).
+
+    ``report`` describes what was made of the tree: the chain's links and
+    joints, the merged fixed joints, the lumped subtrees and the frames
+    rigidly attached to the base and to the tip (for wrenches).
+    """
+    name, root, links, joints = parse_urdf(text, label)
+    base, tip, chain = chain_ends(label, links, joints, root, base, tip)
+    moving = _moving_joints(label, joints, chain, base, tip)
+    pre, merged, tool = _placements(joints, chain, moving)
+    bodies = _Bodies(links, joints, base, chain, moving)
+    tip_frames, base_frames = _attached_frames(
+        links, joints, base, moving, bodies.carried[-1], tool)
     report = {
         'base': base, 'tip': tip, 'chain': chain, 'moving': moving,
         'chain_links': [joints[j].child for j in chain],
         'links': [joints[j].child for j in moving],
-        'merged_fixed': merged, 'lumped': [v for v, *_ in lumped],
+        'merged_fixed': merged, 'lumped': [v for v, _ in bodies.lumped],
         'tip_frames': tip_frames, 'base_frames': base_frames,
         'continuous': [j for j in moving if joints[j].kind == 'continuous'],
     }
@@ -495,12 +518,13 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         name=name, joint_names=moving,
         joint_types=[MOVING[joints[j].kind] for j in moving],
         joint_pre=pre, joint_axis=[joints[j].axis for j in moving],
-        mass=mass, com=com, inertia=inertia, gravity=gravity, tool=tool,
-        limits=limits, info={'source': label, 'urdf': report,
-                             # friction, offset, rotor inertia (or None)
-                             'drives': read_drives(_parse(text, _Source(
-                                 label)), moving, label)})
-    return model, found, report
+        mass=bodies.mass, com=bodies.com, inertia=bodies.inertia,
+        gravity=gravity, tool=tool, limits=_chain_limits(joints, moving),
+        info={'source': label, 'urdf': report,
+              # friction, offset, rotor inertia (or None)
+              'drives': read_drives(_parse(text, _Source(label)), moving,
+                                    label)})
+    return model, _tree_warnings(label, links, joints, bodies), report
 
 
 def inspect_urdf(text_or_path, base=None, tip=None, label=None,

@@ -167,6 +167,114 @@ def _pick(values, idx):
     return a[idx]
 
 
+def _decoded(reader, conns, label, topic, counts):
+    """Yield (logtime, message) on ``conns`` in order; BagError if corrupt."""
+    stream = _windowed(reader, conns)
+    while True:
+        try:
+            conn, logtime, raw = next(stream)
+        except StopIteration:
+            return
+        except Exception as err:  # noqa: BLE001
+            raise BagError(f'{label}: the bag is corrupt or truncated '
+                           f'after {counts["messages"]} messages: '
+                           f'{_one_line(err)}') from None
+        try:
+            msg = reader.deserialize(raw, conn.msgtype)
+        except Exception as err:  # noqa: BLE001
+            raise BagError(f'{label}: message {counts["messages"]} on '
+                           f'{topic!r} cannot be decoded (corrupt '
+                           f'bag?): {_one_line(err)}') from None
+        counts['messages'] += 1
+        yield logtime, msg
+
+
+class _Samples:
+    """
+    The chain's samples (t ns, q, qd or None, effort) of JointStates.
+
+    ``take`` returns None for a message it drops, and counts why: a
+    chain joint missing, no position or effort, a stamp going back, a
+    duplicate.  Zero header stamps: the recording time is used instead.
+    """
+
+    def __init__(self, select, counts, notes):
+        self.select, self.counts, self.notes = select, counts, notes
+        self.last_t = self.last_vals = None
+        self.have_qd = True
+        self.use_logtime = None
+        self.missing_seen = None
+
+    def take(self, logtime, msg):
+        idx = self.select(msg.name)
+        if isinstance(idx, list):
+            self.counts['missing_joint'] += 1
+            self.missing_seen = idx
+            return None
+        q = _pick(msg.position, idx)
+        if q is None:
+            self.counts['no_position'] += 1
+            return None
+        e = _pick(msg.effort, idx)
+        if e is None:
+            self.counts['no_effort'] += 1
+            return None
+        v = _pick(msg.velocity, idx)
+        if v is None:
+            self.have_qd = False
+        t = self._time(logtime, msg.header.stamp)
+        vals = (q, v, e)
+        if self.last_t is not None:
+            if t < self.last_t:
+                self.counts['backwards'] += 1
+                return None
+            if t == self.last_t or _same(vals, self.last_vals):
+                self.counts['duplicates'] += 1
+                return None
+        self.last_t, self.last_vals = t, vals
+        self.counts['kept'] += 1
+        return t, q, v, e
+
+    def _time(self, logtime, stamp):
+        stamp = stamp.sec * 1_000_000_000 + stamp.nanosec
+        if self.use_logtime is None:
+            self.use_logtime = stamp == 0
+            if self.use_logtime:
+                self.notes.append('header stamps are zero: using the '
+                                  'recording time')
+        return int(logtime) if self.use_logtime else int(stamp)
+
+
+class _Chunk:
+    """Preallocated arrays filled with samples, emptied as JointStates."""
+
+    def __init__(self, size, n):
+        self.t = np.empty(size, dtype=np.int64)
+        self.q, self.v, self.e = (np.empty((size, n)) for _ in range(3))
+        self.k = 0
+        self.t0 = None
+
+    def add(self, t, q, v, e):
+        """Store one sample; return True when the chunk is full."""
+        if self.t0 is None:
+            self.t0 = t
+        k = self.k
+        self.t[k], self.q[k], self.e[k] = t, q, e
+        self.v[k] = v if v is not None else np.nan
+        self.k += 1
+        return self.k == len(self.t)
+
+    def take(self, have_qd, names, counts, notes):
+        """Return the samples stored as JointStates and empty the chunk."""
+        k, self.k = self.k, 0
+        t = self.t[:k].copy()
+        return JointStates(
+            stamps=(t - self.t0) * 1e-9, q=self.q[:k].copy(),
+            qd=self.v[:k].copy() if have_qd else None,
+            effort=self.e[:k].copy(), stamps_ns=t, names=names,
+            t0_ns=self.t0, counts=dict(counts), notes=list(notes))
+
+
 def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
                       chunk=DEFAULT_CHUNK, min_samples=MIN_SAMPLES):
     """
@@ -181,8 +289,6 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
     """
     label = _label(path)
     joint_names = tuple(joint_names)
-    n = len(joint_names)
-    select = _Selector(joint_names, label, topic)
     reader = _open(path)
     counts = {'messages': 0, 'kept': 0, 'duplicates': 0, 'backwards': 0,
               'no_effort': 0, 'no_position': 0, 'missing_joint': 0}
@@ -191,84 +297,17 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
         conns = _connections(reader, label, topic)
         if sum(c.msgcount for c in conns) == 0:
             raise BagError(f'{label}: topic {topic!r} has no messages')
-        buf_t = np.empty(chunk, dtype=np.int64)
-        buf_q = np.empty((chunk, n))
-        buf_v = np.empty((chunk, n))
-        buf_e = np.empty((chunk, n))
-        k = 0
-        last_t = None
-        last_vals = None
-        have_qd = True
-        use_logtime = None
-        missing_seen = None
-        t0 = None
-        stream = _windowed(reader, conns)
-        while True:
-            try:
-                item = next(stream)
-            except StopIteration:
-                break
-            except Exception as err:  # noqa: BLE001
-                raise BagError(f'{label}: the bag is corrupt or truncated '
-                               f'after {counts["messages"]} messages: '
-                               f'{_one_line(err)}') from None
-            conn, logtime, raw = item
-            try:
-                msg = reader.deserialize(raw, conn.msgtype)
-            except Exception as err:  # noqa: BLE001
-                raise BagError(f'{label}: message {counts["messages"]} on '
-                               f'{topic!r} cannot be decoded (corrupt '
-                               f'bag?): {_one_line(err)}') from None
-            counts['messages'] += 1
-            idx = select(msg.name)
-            if isinstance(idx, list):
-                counts['missing_joint'] += 1
-                missing_seen = idx
-                continue
-            q = _pick(msg.position, idx)
-            if q is None:
-                counts['no_position'] += 1
-                continue
-            e = _pick(msg.effort, idx)
-            if e is None:
-                counts['no_effort'] += 1
-                continue
-            v = _pick(msg.velocity, idx)
-            if v is None:
-                have_qd = False
-            stamp = msg.header.stamp.sec * 1_000_000_000 \
-                + msg.header.stamp.nanosec
-            if use_logtime is None:
-                use_logtime = stamp == 0
-                if use_logtime:
-                    notes.append('header stamps are zero: using the '
-                                 'recording time')
-            t = int(logtime) if use_logtime else int(stamp)
-            vals = (q, v, e)
-            if last_t is not None:
-                if t < last_t:
-                    counts['backwards'] += 1
-                    continue
-                if t == last_t or _same(vals, last_vals):
-                    counts['duplicates'] += 1
-                    continue
-            last_t, last_vals = t, vals
-            if t0 is None:
-                t0 = t
-            buf_t[k] = t
-            buf_q[k] = q
-            buf_e[k] = e
-            buf_v[k] = v if v is not None else np.nan
-            k += 1
-            counts['kept'] += 1
-            if k == chunk:
-                yield _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd,
-                             joint_names, t0, counts, notes)
-                k = 0
-        _check_totals(label, topic, counts, missing_seen, min_samples)
-        if k:
-            yield _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd,
-                         joint_names, t0, counts, notes)
+        samples = _Samples(_Selector(joint_names, label, topic), counts,
+                           notes)
+        buf = _Chunk(chunk, len(joint_names))
+        for logtime, msg in _decoded(reader, conns, label, topic, counts):
+            sample = samples.take(logtime, msg)
+            if sample is not None and buf.add(*sample):
+                yield buf.take(samples.have_qd, joint_names, counts, notes)
+        _check_totals(label, topic, counts, samples.missing_seen,
+                      min_samples)
+        if buf.k:
+            yield buf.take(samples.have_qd, joint_names, counts, notes)
     finally:
         try:
             reader.close()
@@ -299,16 +338,6 @@ def _same(a, b):
         if x is not None and not np.array_equal(x, y):
             return False
     return True
-
-
-def _chunk(buf_t, buf_q, buf_v, buf_e, k, have_qd, names, t0, counts,
-           notes):
-    t = buf_t[:k].copy()
-    return JointStates(
-        stamps=(t - t0) * 1e-9, q=buf_q[:k].copy(),
-        qd=buf_v[:k].copy() if have_qd else None, effort=buf_e[:k].copy(),
-        stamps_ns=t, names=names, t0_ns=t0, counts=dict(counts),
-        notes=list(notes))
 
 
 def _check_totals(label, topic, counts, missing_seen, min_samples):

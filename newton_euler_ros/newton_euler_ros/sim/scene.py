@@ -221,6 +221,126 @@ def _reference(block, n, q0, where):
                          f'got {_short(kind)!r}')
 
 
+def _gravity(value, model, w):
+    """Return (model, on): ``gravity`` true, false or [gx, gy, gz]."""
+    if isinstance(value, list):
+        return model.replace(gravity=to_vector(value, 3,
+                                               f'{w}.gravity')), True
+    if not isinstance(value, bool):
+        raise RobotFileError(f'{w}.gravity: must be true, false or '
+                             f'[gx, gy, gz], got {_short(value)!r}')
+    return model, value
+
+
+def _payload(block, model, w):
+    """Return the model carrying the ``payload`` block's rigid body."""
+    if not isinstance(block, dict):
+        raise RobotFileError(f'{w}.payload: must give mass, com, inertia')
+    _check_keys(block, {'mass', 'com', 'inertia'}, f'{w}.payload')
+    mass = to_number(block.get('mass'), f'{w}.payload.mass')
+    if mass < 0.0:
+        raise RobotFileError(f'{w}.payload.mass: must be >= 0')
+    com = to_vector(block.get('com', [0.0] * 3), 3, f'{w}.payload.com')
+    inertia = inertia_matrix(*to_vector(block.get('inertia', [0.0] * 6),
+                                        6, f'{w}.payload.inertia'))
+    if not principal_moments(inertia)[1]:
+        raise RobotFileError(f'{w}.payload.inertia: must be positive '
+                             f'semidefinite')
+    return with_payload(model, mass, com, inertia)
+
+
+def _friction(block, n, w):
+    """Return (viscous, coulomb) per joint from the ``friction`` block."""
+    if not isinstance(block, dict):
+        raise RobotFileError(f'{w}.friction: must give viscous and/or '
+                             f'coulomb')
+    _check_keys(block, {'viscous', 'coulomb'}, f'{w}.friction')
+    return (_per_joint(block.get('viscous', 0.0), n,
+                       f'{w}.friction.viscous'),
+            _per_joint(block.get('coulomb', 0.0), n,
+                       f'{w}.friction.coulomb'))
+
+
+def _effects(eff, model, origin):
+    """
+    Read the ``effects`` block; return (model, effects, extras).
+
+    ``extras`` holds the per-joint viscous, coulomb and armature arrays
+    (zeros where off) and the wrench (None where off).
+    """
+    w = f'{origin}: effects'
+    _check_keys(eff, EFFECT_KEYS, w)
+    n = model.n
+    model, gravity = _gravity(eff.get('gravity', True), model, w)
+    velocity = eff.get('velocity_products', True)
+    if not isinstance(velocity, bool):
+        raise RobotFileError(f'{w}.velocity_products: must be true or false')
+    payload_on, block = _flag_or_block(eff.get('payload'), f'{w}.payload')
+    if payload_on:
+        model = _payload(block, model, w)
+    wrench_on, block = _flag_or_block(eff.get('wrench'), f'{w}.wrench')
+    wrench = None
+    if wrench_on:
+        if not isinstance(block, dict):
+            raise RobotFileError(f'{w}.wrench: must give frame and one of '
+                                 f'constant, schedule, source')
+        wrench = _wrench(block, f'{w}.wrench')
+    friction_on, block = _flag_or_block(eff.get('friction'),
+                                        f'{w}.friction')
+    viscous, coulomb = (_friction(block, n, w) if friction_on
+                        else (np.zeros(n), np.zeros(n)))
+    armature_on = eff.get('armature') not in (None, False)
+    armature = (_per_joint(eff['armature'], n, f'{w}.armature')
+                if armature_on else np.zeros(n))
+    effects = Effects(gravity, velocity, payload_on, wrench_on, friction_on,
+                      armature_on)
+    return model, effects, {'viscous': viscous, 'coulomb': coulomb,
+                            'armature': armature, 'wrench': wrench}
+
+
+def _initial(init, n, origin):
+    """Return (q0, qd0) of the ``initial`` block (zeros by default)."""
+    _check_keys(init, {'q', 'qd'}, f'{origin}: initial')
+    return (np.array(to_vector(init.get('q', [0.0] * n), n,
+                               f'{origin}: initial.q')),
+            np.array(to_vector(init.get('qd', [0.0] * n), n,
+                               f'{origin}: initial.qd')))
+
+
+def _controller(ctrl, n, origin):
+    """Return {kp, kd, feedforward} of the ``controller`` block."""
+    _check_keys(ctrl, {'kp', 'kd', 'feedforward'}, f'{origin}: controller')
+    gains = {key: _per_joint(ctrl.get(key, 0.0), n,
+                             f'{origin}: controller.{key}')
+             for key in ('kp', 'kd')}
+    feedforward = ctrl.get('feedforward', True)
+    if not isinstance(feedforward, bool):
+        raise RobotFileError(f'{origin}: controller.feedforward: must be '
+                             f'true or false')
+    return dict(gains, feedforward=feedforward)
+
+
+def _integrator(integ, origin):
+    """Return {integrator, step, duration, rate} of the ``integrator`` block."""
+    _check_keys(integ, {'method', 'step', 'duration', 'rate'},
+                f'{origin}: integrator')
+    method = integ.get('method', 'rk4')
+    if method not in INTEGRATORS:
+        raise RobotFileError(f'{origin}: integrator.method: must be one of '
+                             f'{", ".join(INTEGRATORS)}, got {_short(method)!r}')
+    values = {'step': to_number(integ.get('step'),
+                                f'{origin}: integrator.step'),
+              'duration': to_number(integ.get('duration'),
+                                    f'{origin}: integrator.duration'),
+              'rate': to_number(integ.get('rate', 250.0),
+                                f'{origin}: integrator.rate')}
+    for key, value in values.items():
+        if value <= 0.0:
+            raise RobotFileError(f'{origin}: integrator.{key}: must be > 0, '
+                                 f'got {value}')
+    return dict(values, integrator=method)
+
+
 def scene_from_dict(data, origin, base_dir='.'):
     """Validate a parsed scene; ``base_dir`` resolves a relative robot."""
     _check_keys(data, SCENE_KEYS, origin)
@@ -231,115 +351,22 @@ def scene_from_dict(data, origin, base_dir='.'):
     candidate = os.path.join(base_dir, robot)
     model, found, robot_path = inspect_robot(
         candidate if os.path.isfile(candidate) else robot)
-    n = model.n
-    eff = data.get('effects') or {}
-    _check_keys(eff, EFFECT_KEYS, f'{origin}: effects')
-    w = f'{origin}: effects'
-
-    gravity = eff.get('gravity', True)
-    if isinstance(gravity, list):
-        model = model.replace(gravity=to_vector(gravity, 3,
-                                                f'{w}.gravity'))
-        gravity = True
-    elif not isinstance(gravity, bool):
-        raise RobotFileError(f'{w}.gravity: must be true, false or '
-                             f'[gx, gy, gz], got {_short(gravity)!r}')
-    velocity = eff.get('velocity_products', True)
-    if not isinstance(velocity, bool):
-        raise RobotFileError(f'{w}.velocity_products: must be true or false')
-
-    payload_on, block = _flag_or_block(eff.get('payload'), f'{w}.payload')
-    if payload_on:
-        if not isinstance(block, dict):
-            raise RobotFileError(f'{w}.payload: must give mass, com, '
-                                 f'inertia')
-        _check_keys(block, {'mass', 'com', 'inertia'}, f'{w}.payload')
-        mass = to_number(block.get('mass'), f'{w}.payload.mass')
-        if mass < 0.0:
-            raise RobotFileError(f'{w}.payload.mass: must be >= 0')
-        com = to_vector(block.get('com', [0.0] * 3), 3, f'{w}.payload.com')
-        inertia = inertia_matrix(*to_vector(block.get('inertia', [0.0] * 6),
-                                            6, f'{w}.payload.inertia'))
-        if not principal_moments(inertia)[1]:
-            raise RobotFileError(f'{w}.payload.inertia: must be positive '
-                                 f'semidefinite')
-        model = with_payload(model, mass, com, inertia)
-
-    wrench_on, block = _flag_or_block(eff.get('wrench'), f'{w}.wrench')
-    wrench = None
-    if wrench_on:
-        if not isinstance(block, dict):
-            raise RobotFileError(f'{w}.wrench: must give frame and one of '
-                                 f'constant, schedule, source')
-        wrench = _wrench(block, f'{w}.wrench')
-
-    friction_on, block = _flag_or_block(eff.get('friction'),
-                                        f'{w}.friction')
-    viscous, coulomb = np.zeros(n), np.zeros(n)   # two arrays, not one
-    if friction_on:
-        if not isinstance(block, dict):
-            raise RobotFileError(f'{w}.friction: must give viscous and/or '
-                                 f'coulomb')
-        _check_keys(block, {'viscous', 'coulomb'}, f'{w}.friction')
-        viscous = _per_joint(block.get('viscous', 0.0), n,
-                             f'{w}.friction.viscous')
-        coulomb = _per_joint(block.get('coulomb', 0.0), n,
-                             f'{w}.friction.coulomb')
-
-    armature_on = eff.get('armature') not in (None, False)
-    armature = (_per_joint(eff['armature'], n, f'{w}.armature')
-                if armature_on else np.zeros(n))
-
-    effects = Effects(gravity, velocity, payload_on, wrench_on, friction_on,
-                      armature_on)
-
-    init = data.get('initial') or {}
-    _check_keys(init, {'q', 'qd'}, f'{origin}: initial')
-    q0 = np.array(to_vector(init.get('q', [0.0] * n), n,
-                            f'{origin}: initial.q'))
-    qd0 = np.array(to_vector(init.get('qd', [0.0] * n), n,
-                             f'{origin}: initial.qd'))
-
+    model, effects, extras = _effects(data.get('effects') or {}, model,
+                                      origin)
+    q0, qd0 = _initial(data.get('initial') or {}, model.n, origin)
     ref_block = data.get('reference') or {'type': 'quintic',
                                           'goal': q0.tolist(),
                                           'duration': 1.0}
-    reference = _reference(ref_block, n, q0, f'{origin}: reference')
-
-    ctrl = data.get('controller') or {}
-    _check_keys(ctrl, {'kp', 'kd', 'feedforward'}, f'{origin}: controller')
-    kp = _per_joint(ctrl.get('kp', 0.0), n, f'{origin}: controller.kp')
-    kd = _per_joint(ctrl.get('kd', 0.0), n, f'{origin}: controller.kd')
-    feedforward = ctrl.get('feedforward', True)
-    if not isinstance(feedforward, bool):
-        raise RobotFileError(f'{origin}: controller.feedforward: must be '
-                             f'true or false')
-
-    integ = data['integrator']
-    _check_keys(integ, {'method', 'step', 'duration', 'rate'},
-                f'{origin}: integrator')
-    method = integ.get('method', 'rk4')
-    if method not in INTEGRATORS:
-        raise RobotFileError(f'{origin}: integrator.method: must be one of '
-                             f'{", ".join(INTEGRATORS)}, got {_short(method)!r}')
-    step = to_number(integ.get('step'), f'{origin}: integrator.step')
-    duration = to_number(integ.get('duration'),
-                         f'{origin}: integrator.duration')
-    rate = to_number(integ.get('rate', 250.0), f'{origin}: integrator.rate')
-    for key, value in (('step', step), ('duration', duration),
-                       ('rate', rate)):
-        if value <= 0.0:
-            raise RobotFileError(f'{origin}: integrator.{key}: must be > 0, '
-                                 f'got {value}')
+    reference = _reference(ref_block, model.n, q0, f'{origin}: reference')
+    controller = _controller(data.get('controller') or {}, model.n, origin)
+    integrator = _integrator(data['integrator'], origin)
     name = data['name']
     if not isinstance(name, str) or not name:
         raise RobotFileError(f'{origin}: name: must be a non-empty string')
     return Scene(name=name, description=str(data.get('description', '')),
                  path=origin, robot_path=robot_path, model=model,
-                 effects=effects, viscous=viscous, coulomb=coulomb,
-                 armature=armature, wrench=wrench, q0=q0, qd0=qd0,
-                 reference=reference, kp=kp, kd=kd, feedforward=feedforward,
-                 integrator=method, step=step, duration=duration, rate=rate,
-                 warnings=tuple(found))
+                 effects=effects, q0=q0, qd0=qd0, reference=reference,
+                 warnings=tuple(found), **extras, **controller, **integrator)
 
 
 def scene_dirs():
