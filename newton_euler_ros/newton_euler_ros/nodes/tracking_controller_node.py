@@ -28,7 +28,9 @@ node's torques for the same stamp, read from ``~/feedforward`` (remap it
 to ``/inverse_dynamics_node/torques``; the node waits for them).  With
 ``feedforward`` false, ff = 0 and every state is answered at once.
 ``joint_states`` is subscribed only once the peers are matched
-(``wait_for_subscribers``).  The remaps of the closed loop are
+(``wait_for_subscribers``).  On a stop it waits up to ACK_WAIT
+seconds for every command to be acknowledged, then logs ``commands
+sent: N``.  The remaps of the closed loop are
 :data:`..graph.CONTROLLER_REMAPS` (used by launch/closed_loop.launch.py
 and the demo).
 
