@@ -23,6 +23,8 @@
     newton-euler urdf ROBOT [-o FILE]
     newton-euler feedforward ROBOT TRAJECTORY.json [--wrench ...]
     newton-euler robots
+    newton-euler excite | identify | replay | payload | observe ...
+    newton-euler send TRAJECTORY.json | record BAG   (on a live ROS graph)
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
 (``.urdf``, with ``--base LINK --tip LINK`` to choose the chain).  Every
@@ -40,6 +42,7 @@ import numpy as np
 from .cli_identify import register as register_identify
 from .cli_loop import register as register_loop
 from .cli_observe import register as register_observe
+from .cli_ros import register as register_ros, RosCliError
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
                    RobotFileError)
@@ -419,6 +422,7 @@ def build_parser():
     register_identify(sub)
     register_observe(sub)
     register_loop(sub)
+    register_ros(sub)
     return parser
 
 
@@ -431,7 +435,7 @@ def main(argv=None):
             parser.print_help()
             return EXIT_USAGE
         return args.func(args)
-    except CliError as exc:
+    except (CliError, RosCliError) as exc:
         print(f'newton-euler: error: {exc}', file=sys.stderr)
         return EXIT_USAGE
     except NewtonEulerError as exc:

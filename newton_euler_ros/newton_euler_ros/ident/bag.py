@@ -393,6 +393,31 @@ def recording_seconds(path):
         reader.close()
 
 
+def open_writer(path, topic=DEFAULT_TOPIC, storage='mcap'):
+    """
+    Open a rosbag2 recording of JointState on ``topic`` for writing.
+
+    Return (writer, connection, typestore); ``writer.write(connection,
+    logtime_ns, cdr_bytes)`` adds a message, ``writer.close()`` ends the
+    bag.  ``storage`` is ``'mcap'`` or ``'sqlite3'``; ``path`` must not
+    exist.
+    """
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import get_typestore, Stores
+
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    plugin = {'mcap': StoragePlugin.MCAP,
+              'sqlite3': StoragePlugin.SQLITE3}[storage]
+    writer = Writer(Path(path), version=9, storage_plugin=plugin)
+    writer.open()
+    try:
+        conn = writer.add_connection(topic, JOINT_STATE, typestore=ts)
+    except Exception:
+        writer.close()
+        raise
+    return writer, conn, ts
+
+
 def write_joint_states(path, stamps_ns, names, q, qd, effort,
                        topic=DEFAULT_TOPIC, storage='mcap',
                        logtimes_ns=None):
@@ -404,22 +429,16 @@ def write_joint_states(path, stamps_ns, names, q, qd, effort,
     empty.  ``storage`` is ``'mcap'`` or ``'sqlite3'``; ``logtimes_ns``
     the recording times (default: the stamps).  ``path`` must not exist.
     """
-    from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.typesys import get_typestore, Stores
-
-    ts = get_typestore(Stores.ROS2_JAZZY)
-    JointState = ts.types['sensor_msgs/msg/JointState']
-    Header = ts.types['std_msgs/msg/Header']
-    Time = ts.types['builtin_interfaces/msg/Time']
-    plugin = {'mcap': StoragePlugin.MCAP,
-              'sqlite3': StoragePlugin.SQLITE3}[storage]
     stamps_ns = np.asarray(stamps_ns, dtype=np.int64)
     logtimes = stamps_ns if logtimes_ns is None else np.asarray(
         logtimes_ns, dtype=np.int64)
     empty = np.zeros(0)
     names = list(names)
-    with Writer(Path(path), version=9, storage_plugin=plugin) as writer:
-        conn = writer.add_connection(topic, JOINT_STATE, typestore=ts)
+    writer, conn, ts = open_writer(path, topic, storage)
+    JointState = ts.types['sensor_msgs/msg/JointState']
+    Header = ts.types['std_msgs/msg/Header']
+    Time = ts.types['builtin_interfaces/msg/Time']
+    try:
         for i, t in enumerate(stamps_ns):
             t = int(t)
             msg = JointState(
@@ -434,3 +453,5 @@ def write_joint_states(path, stamps_ns, names, q, qd, effort,
                         else np.asarray(effort[i], dtype=np.float64)))
             writer.write(conn, int(logtimes[i]),
                          ts.serialize_cdr(msg, JOINT_STATE))
+    finally:
+        writer.close()

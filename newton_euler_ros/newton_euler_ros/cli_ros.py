@@ -1,0 +1,366 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+``newton-euler send`` and ``newton-euler record``: the loop on a live graph.
+
+    newton-euler send TRAJECTORY.json [--topic T] [--start-in S] [--wait S]
+                      [--no-follow]
+    newton-euler record BAG [--topic T] [--duration S] [--max-messages N]
+                        [--storage mcap|sqlite3] [--wait S]
+
+``send`` publishes a JointTrajectory JSON file (``excite``'s output, or
+``feedforward``'s) once, as a ``trajectory_msgs/JointTrajectory``: to
+inverse_dynamics_node's ``~/trajectory_in`` (efforts filled, passed on to
+the controller) or straight to joint_trajectory_controller's
+``~/joint_trajectory``.  It waits for a subscriber, for the message to be
+acknowledged and (unless ``--no-follow``) for the trajectory to end.
+
+``record`` writes ``sensor_msgs/JointState`` messages to a rosbag2 (MCAP
+by default) as they arrive, raw (no decoding on the way), with the
+arrival time as the recording time: what ``identify``, ``payload`` and
+``observe`` read, without the ``ros2`` CLI.  Its subscription is reliable
+unless a publisher on the topic is best effort.  It stops after
+``--duration`` seconds of recording, ``--max-messages`` messages, or on
+Ctrl-C (SIGINT) or SIGTERM; the bag is complete in every case.
+
+Both need rclpy (the ROS 2 wheels of ``make setup``); every other command
+of ``newton-euler`` runs without it.
+"""
+import math
+import os
+import shutil
+import signal
+import sys
+import time
+
+from .core.text import read_text
+
+MAX_TRAJECTORY_BYTES = 64 * 1024 * 1024
+MAX_POINTS = 1_000_000
+FIELDS = ('positions', 'velocities', 'accelerations', 'effort')
+JOINT_STATE = 'sensor_msgs/msg/JointState'
+
+
+class RosCliError(Exception):
+    """A bad input or a graph that cannot serve: one line, exit status 2."""
+
+
+def register(subparsers):
+    """Add the ``send`` and ``record`` commands to ``subparsers``."""
+    snd = subparsers.add_parser(
+        'send', help='publish a JointTrajectory JSON file once (to the '
+                     "node's ~/trajectory_in or a controller)")
+    snd.add_argument('trajectory', help='JointTrajectory JSON file')
+    snd.add_argument('--topic', default='/inverse_dynamics_node/'
+                     'trajectory_in', help='where to publish (default: '
+                     '%(default)s)')
+    snd.add_argument('--start-in', type=float, default=0.5, metavar='S',
+                     help='stamp the trajectory to start S seconds from '
+                          'now (0: a zero stamp, "start on receipt"; '
+                          'default %(default)s)')
+    snd.add_argument('--wait', type=float, default=10.0, metavar='S',
+                     help='seconds to wait for a subscriber (default '
+                          '%(default)s)')
+    snd.add_argument('--no-follow', action='store_true',
+                     help='return once the message is acknowledged, not '
+                          'when the trajectory ends')
+    snd.set_defaults(func=cmd_send)
+    rec = subparsers.add_parser(
+        'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
+    rec.add_argument('bag', help='rosbag2 directory to create (must not '
+                                 'exist)')
+    rec.add_argument('--topic', default='/joint_states',
+                     help='JointState topic (default: %(default)s)')
+    rec.add_argument('--duration', type=float, metavar='S',
+                     help='stop after S seconds from the first message')
+    rec.add_argument('--max-messages', type=int, metavar='N',
+                     help='stop after N messages')
+    rec.add_argument('--storage', choices=('mcap', 'sqlite3'),
+                     default='mcap', help='bag storage (default: '
+                                          '%(default)s)')
+    rec.add_argument('--wait', type=float, default=30.0, metavar='S',
+                     help='seconds to wait for a publisher (default '
+                          '%(default)s)')
+    rec.set_defaults(func=cmd_record)
+
+
+# ---- the trajectory file -------------------------------------------------
+
+def _finite_list(value, n, where):
+    if not isinstance(value, list) or len(value) != n:
+        raise RosCliError(f'{where}: must be a list of {n} numbers')
+    out = []
+    for x in value:
+        if isinstance(x, bool) or not isinstance(x, (int, float)) \
+                or not math.isfinite(x):
+            raise RosCliError(f'{where}: must be finite numbers, got '
+                              f'{str(x)[:40]!r}')
+        out.append(float(x))
+    return out
+
+
+def read_trajectory(path):
+    """
+    Return (joint_names, points) of a JointTrajectory JSON file.
+
+    ``points`` are dicts with ``time_from_start`` (s, strictly
+    increasing) and any of positions, velocities, accelerations, effort
+    (one number per joint).  Every error is one line naming the file, the
+    point and the field.
+    """
+    import json
+    text = read_text(path, MAX_TRAJECTORY_BYTES, 'trajectory JSON file')
+    try:
+        data = json.loads(text)
+    except (json.JSONDecodeError, RecursionError) as exc:
+        raise RosCliError(f'{path}: not valid JSON: '
+                          f'{str(exc)[:200]}') from None
+    if not isinstance(data, dict):
+        raise RosCliError(f'{path}: must hold a JSON object with '
+                          f'"joint_names" and "points"')
+    names, points = data.get('joint_names'), data.get('points')
+    if not isinstance(names, list) or not names or not all(
+            isinstance(x, str) and x for x in names) \
+            or len(set(names)) != len(names):
+        raise RosCliError(f'{path}: joint_names: must be a list of distinct '
+                          f'non-empty names')
+    if not isinstance(points, list) or not points:
+        raise RosCliError(f'{path}: points: must be a non-empty list')
+    if len(points) > MAX_POINTS:
+        raise RosCliError(f'{path}: points: {len(points)} points, at most '
+                          f'{MAX_POINTS}')
+    out, last = [], -math.inf
+    for i, point in enumerate(points):
+        where = f'{path}: points[{i}]'
+        if not isinstance(point, dict):
+            raise RosCliError(f'{where}: must be an object')
+        t = point.get('time_from_start')
+        if isinstance(t, bool) or not isinstance(t, (int, float)) \
+                or not math.isfinite(t) or t < 0.0 or not t > last:
+            raise RosCliError(f'{where}.time_from_start: must be a finite '
+                              f'number >= 0, larger than the previous '
+                              f"point's, got {str(t)[:40]!r}")
+        last = t
+        fields = {f: _finite_list(point[f], len(names), f'{where}.{f}')
+                  for f in FIELDS if point.get(f) not in (None, [])}
+        out.append(dict(fields, time_from_start=float(t)))
+    return names, out
+
+
+def trajectory_message(names, points, stamp_ns):
+    """Return the JointTrajectory of ``points``, stamped ``stamp_ns`` (0: now)."""
+    from builtin_interfaces.msg import Duration
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+    msg = JointTrajectory(joint_names=list(names))
+    msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(stamp_ns,
+                                                            10 ** 9)
+    for point in points:
+        sec, nanosec = divmod(int(round(point['time_from_start'] * 1e9)),
+                              10 ** 9)
+        msg.points.append(JointTrajectoryPoint(
+            time_from_start=Duration(sec=sec, nanosec=nanosec),
+            **{f: point[f] for f in FIELDS if f in point}))
+    return msg
+
+
+# ---- running on a graph ----------------------------------------------------
+
+class _Ros:
+    """rclpy in a context of its own, stopped by SIGINT and SIGTERM."""
+
+    def __init__(self, name):
+        import rclpy
+        from rclpy.executors import SingleThreadedExecutor
+        from rclpy.signals import SignalHandlerOptions
+        self.stop = []
+        self._old = {}
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            self._old[sig] = signal.signal(
+                sig, lambda signum, frame: self.stop.append(signum))
+        self.rclpy = rclpy
+        self.context = rclpy.Context()
+        rclpy.init(context=self.context,
+                   signal_handler_options=SignalHandlerOptions.NO)
+        self.node = rclpy.create_node(name, context=self.context)
+        self.executor = SingleThreadedExecutor(context=self.context)
+        self.executor.add_node(self.node)
+
+    def spin_until(self, predicate, timeout):
+        """Spin until ``predicate()``, a stop, or ``timeout`` s (None: never)."""
+        end = None if timeout is None else time.monotonic() + timeout
+        while not predicate() and not self.stop:
+            if end is not None and time.monotonic() >= end:
+                return False
+            self.executor.spin_once(timeout_sec=0.05)
+        return predicate()
+
+    def close(self):
+        self.executor.shutdown()
+        self.node.destroy_node()
+        self.rclpy.try_shutdown(context=self.context)
+        for sig, handler in self._old.items():
+            signal.signal(sig, handler)
+
+
+def _check_seconds(value, option, allow_zero=True):
+    if not math.isfinite(value) or value < 0.0 or (
+            not allow_zero and value == 0.0):
+        raise RosCliError(f'{option}: must be a finite number '
+                          f'{">=" if allow_zero else ">"} 0, got {value}')
+
+
+def cmd_send(args):
+    """Publish a trajectory file once; follow it to its end."""
+    for option in ('start_in', 'wait'):
+        _check_seconds(getattr(args, option), '--' + option.replace('_', '-'))
+    names, points = read_trajectory(args.trajectory)
+    from rclpy.duration import Duration
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from trajectory_msgs.msg import JointTrajectory
+    ros = _Ros('newton_euler_send')
+    try:
+        pub = ros.node.create_publisher(
+            JointTrajectory, args.topic,
+            QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
+        if not ros.spin_until(lambda: pub.get_subscription_count() > 0,
+                              args.wait):
+            if ros.stop:
+                return 130
+            raise RosCliError(f'no subscriber on {args.topic} after '
+                              f'{args.wait:g} s (is the node or the '
+                              f'controller running, in this ROS_DOMAIN_ID?)')
+        now = ros.node.get_clock().now().nanoseconds
+        start = now + int(args.start_in * 1e9) if args.start_in > 0 else 0
+        pub.publish(trajectory_message(names, points, start))
+        if not pub.wait_for_all_acked(Duration(seconds=5.0)):
+            print(f'newton-euler: warning: {args.topic}: not acknowledged '
+                  f'within 5 s', file=sys.stderr)
+        end_s = args.start_in + points[-1]['time_from_start']
+        print(f'sent {len(points)} points for {len(names)} joints to '
+              f'{args.topic}, starting in {args.start_in:g} s, '
+              f'{points[-1]["time_from_start"]:g} s long', flush=True)
+        if not args.no_follow:
+            done = time.monotonic() + end_s
+            ros.spin_until(lambda: time.monotonic() >= done, None)
+            if ros.stop:
+                return 130
+            print('trajectory ended', flush=True)
+    finally:
+        ros.close()
+    return 0
+
+
+class _Recorder:
+    """Writes each raw JointState to the bag as it arrives."""
+
+    def __init__(self, args):
+        self.args = args
+        self.writer = self.conn = None
+        self.count = 0
+        self.first = self.last = None
+
+    def start(self):
+        from .ident.bag import open_writer
+        self.writer, self.conn, _ = open_writer(self.args.bag,
+                                                self.args.topic,
+                                                self.args.storage)
+
+    def __call__(self, raw):
+        now = time.time_ns()
+        if self.done():
+            return
+        self.writer.write(self.conn, now, bytes(raw))
+        self.count += 1
+        self.first = now if self.first is None else self.first
+        self.last = now
+
+    def done(self):
+        a = self.args
+        return ((a.max_messages is not None and self.count >= a.max_messages)
+                or (a.duration is not None and self.first is not None
+                    and self.last - self.first >= a.duration * 1e9))
+
+    def close(self):
+        if self.writer is not None:
+            self.writer.close()
+
+
+def _check_record_args(args):
+    bag = args.bag
+    if os.path.lexists(bag):
+        raise RosCliError(f'{bag}: already exists (a recording is never '
+                          f'overwritten)')
+    parent = os.path.dirname(os.path.abspath(bag))
+    if not os.path.isdir(parent):
+        raise RosCliError(f'{bag}: no such directory {parent}')
+    _check_seconds(args.wait, '--wait')
+    if args.duration is not None:
+        _check_seconds(args.duration, '--duration', allow_zero=False)
+    if args.max_messages is not None and args.max_messages < 1:
+        raise RosCliError(f'--max-messages: must be >= 1, got '
+                          f'{args.max_messages}')
+
+
+def _publishers(ros, topic):
+    """(types, any best effort) of the publishers on ``topic``."""
+    from rclpy.qos import ReliabilityPolicy
+    infos = ros.node.get_publishers_info_by_topic(topic)
+    return ({i.topic_type for i in infos},
+            any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+                for i in infos))
+
+
+def cmd_record(args):
+    """Record JointState messages into a new rosbag2."""
+    _check_record_args(args)
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    ros = _Ros('newton_euler_record')
+    rec = _Recorder(args)
+    try:
+        topic = ros.node.resolve_topic_name(args.topic)
+        if not ros.spin_until(lambda: _publishers(ros, topic)[0],
+                              args.wait):
+            if ros.stop:
+                return 130
+            raise RosCliError(f'no publisher on {topic} after '
+                              f'{args.wait:g} s (is the robot driver '
+                              f'running, in this ROS_DOMAIN_ID?)')
+        types, best_effort = _publishers(ros, topic)
+        if types != {JOINT_STATE}:
+            raise RosCliError(f'{topic} carries {", ".join(sorted(types))}, '
+                              f'not {JOINT_STATE}')
+        rec.start()
+        ros.node.create_subscription(
+            JointState, topic, rec, QoSProfile(
+                depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT
+                if best_effort else ReliabilityPolicy.RELIABLE), raw=True)
+        print(f'recording {topic} into {args.bag} '
+              f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
+              f'stops', flush=True)
+        ros.spin_until(rec.done, None)
+    finally:
+        rec.close()
+        ros.close()
+    if not rec.count:
+        if rec.writer is not None:
+            shutil.rmtree(args.bag, ignore_errors=True)
+        print(f'newton-euler: no message received on {args.topic}; no bag '
+              f'written', file=sys.stderr)
+        return 1
+    seconds = (rec.last - rec.first) * 1e-9
+    print(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
+          f'into {args.bag}', flush=True)
+    return 0

@@ -1,0 +1,165 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+``newton-euler send`` and ``record`` as a user runs them, over real DDS.
+
+The robot is robot_sim_node (a Puma 560 standing in for a driver and
+joint_trajectory_controller); inverse_dynamics_node fills the efforts of
+the trajectory ``send`` publishes on its ``~/trajectory_in`` and passes
+it on to the simulator; ``record`` writes ``/joint_states`` to a rosbag2
+that the identification commands read.
+"""
+import json
+import os
+import subprocess
+import sys
+
+from newton_euler_tools.processes import ros_env
+import numpy as np
+import pytest
+
+pytest.importorskip('rclpy')
+
+# After the skip: pytest must be imported first, hence E402 and I100.
+from newton_euler_ros.ident.bag import read_joint_states  # noqa: E402, I100
+from ros_harness import domain_id, id_node_cmd, NodeProcess  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+NAMES = [f'joint{k}' for k in range(1, 7)]
+Q0 = [0.0, 0.3, -0.4, 0.0, 0.3, 0.0]     # puma_pick_and_place's start
+STEP = 0.2          # rad: every joint moves this much
+MOVE = 2.0          # s
+
+
+def cli(*args, domain=None, timeout=60):
+    exe = os.path.join(os.path.dirname(sys.executable), 'newton-euler')
+    base = [exe] if os.path.exists(exe) else [
+        sys.executable, '-m', 'newton_euler_ros.cli']
+    return subprocess.run(base + list(args), capture_output=True, text=True,
+                          timeout=timeout,
+                          env=ros_env(domain if domain is not None
+                                      else domain_id(3)))
+
+
+def write_move(path):
+    """Write a rest-to-rest quintic of every joint by STEP, no efforts."""
+    points = []
+    for t in np.arange(0.0, MOVE + 1e-9, 0.01):
+        s = t / MOVE
+        p = 10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5
+        dp = (30 * s ** 2 - 60 * s ** 3 + 30 * s ** 4) / MOVE
+        points.append({'time_from_start': float(t),
+                       'positions': [q + STEP * p for q in Q0],
+                       'velocities': [STEP * dp] * 6})
+    path.write_text(json.dumps({'joint_names': NAMES, 'points': points}))
+    return path
+
+
+def test_send_through_the_node_and_record_a_bag(tmp_path):
+    domain = domain_id(11)
+    sim_cmd = [os.path.join(os.path.dirname(sys.executable),
+                            'robot_sim_node'), '--ros-args',
+               '-p', 'scene:=puma_pick_and_place',
+               # the recorder and the inverse-dynamics node
+               '-p', 'wait_for_subscribers:=2']
+    node_cmd = id_node_cmd(None, '-p', 'robot_file:=puma560',
+                           '-p', 'mode:=gravity', '-r',
+                           '~/trajectory_out:=/robot_sim_node/'
+                           'joint_trajectory')
+    sim = NodeProcess(sim_cmd, domain, str(tmp_path / 'sim.log'))
+    node = NodeProcess(node_cmd, domain, str(tmp_path / 'node.log'))
+    bag = tmp_path / 'recording'
+    recorder = subprocess.Popen(
+        [os.path.join(os.path.dirname(sys.executable), 'newton-euler'),
+         'record', str(bag), '--duration', str(MOVE + 1.5)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=ros_env(domain))
+    try:
+        sent = cli('send', str(write_move(tmp_path / 'move.json')),
+                   '--wait', '60', domain=domain, timeout=120)
+        assert sent.returncode == 0, sent.stdout + sent.stderr + node.log()
+        assert 'sent 201 points for 6 joints to /inverse_dynamics_node/' \
+            'trajectory_in' in sent.stdout
+        out, err = recorder.communicate(timeout=60)
+    finally:
+        if recorder.poll() is None:
+            recorder.kill()
+        status = [node.stop(), sim.stop()]
+    assert recorder.returncode == 0, out + err
+    assert 'recording /joint_states into' in out and '(reliable)' in out
+    assert status == [0, 0], node.log() + sim.log()
+    # the bag is a rosbag2 the identification commands read
+    states = read_joint_states(str(bag), NAMES)
+    assert states.counts['messages'] >= 0.9 * 250 * (MOVE + 1.5)
+    assert np.all(np.diff(states.stamps_ns) > 0)
+    np.testing.assert_allclose(states.q[0], Q0, atol=1e-12)
+    # the node filled the efforts (gravity): sent straight to the
+    # simulator, the scene's soft PD alone leaves joint 2 about 0.3 rad
+    # below the goal
+    goal = np.array(Q0) + STEP
+    assert np.abs(states.q[-1] - goal).max() < 0.01, states.q[-1] - goal
+    assert np.abs(states.effort).max() > 1.0
+
+
+def test_send_errors_are_one_line(tmp_path):
+    good = write_move(tmp_path / 'move.json')
+    points = json.loads(good.read_text())['points']
+    cases = {
+        'not json': ('{', 'not valid JSON'),
+        'names': (json.dumps({'joint_names': ['a', 'a'], 'points': points}),
+                  'joint_names: must be a list of distinct'),
+        'time': (json.dumps({'joint_names': NAMES, 'points': [
+            points[1], points[0]]}), 'points[1].time_from_start'),
+        'nan': (json.dumps({'joint_names': NAMES, 'points': [
+            dict(points[0], positions=[0.0] * 5 + ['x'])]}),
+            'points[0].positions: must be finite numbers'),
+        'size': (json.dumps({'joint_names': NAMES, 'points': [
+            dict(points[0], velocities=[0.0] * 5)]}),
+            'points[0].velocities: must be a list of 6 numbers'),
+    }
+    for label, (text, expected) in cases.items():
+        path = tmp_path / f'{label.replace(" ", "_")}.json'
+        path.write_text(text)
+        proc = cli('send', str(path), '--wait', '0')
+        assert proc.returncode == 2, (label, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and str(path) in lines[0] \
+            and expected in lines[0], (label, proc.stderr)
+    # a well-formed file and nobody listening: said, and nothing hangs
+    proc = cli('send', str(good), '--topic', '/nobody_here', '--wait', '0.5')
+    assert proc.returncode == 2
+    assert 'no subscriber on /nobody_here after 0.5 s' in proc.stderr
+
+
+def test_record_errors_are_one_line(tmp_path):
+    existing = tmp_path / 'existing'
+    existing.mkdir()
+    for args, expected in (
+            ([str(existing)], 'already exists'),
+            ([str(tmp_path / 'no' / 'bag')], 'no such directory'),
+            ([str(tmp_path / 'bag'), '--duration', '0'],
+             '--duration: must be a finite number > 0'),
+            ([str(tmp_path / 'bag'), '--max-messages', '0'],
+             '--max-messages: must be >= 1'),
+            ([str(tmp_path / 'bag'), '--topic', '/nobody_here', '--wait',
+              '0.5'], 'no publisher on /nobody_here after 0.5 s')):
+        proc = cli('record', *args)
+        assert proc.returncode == 2, (args, proc.stderr)
+        assert len(proc.stderr.strip().splitlines()) == 1 \
+            and expected in proc.stderr, (args, proc.stderr)
+    # nothing was written where nothing could be
+    assert not (tmp_path / 'bag').exists()
+    assert list(existing.iterdir()) == []
