@@ -249,7 +249,8 @@ def cmd_send(args):
                   f'within 5 s', file=sys.stderr)
         end_s = args.start_in + points[-1]['time_from_start']
         print(f'sent {len(points)} points for {len(names)} joints to '
-              f'{args.topic}, starting in {args.start_in:g} s, '
+              f'{args.topic}, starting in {args.start_in:g} s (stamp '
+              f'{start // 10 ** 9}.{start % 10 ** 9:09d}), '
               f'{points[-1]["time_from_start"]:g} s long', flush=True)
         if not args.no_follow:
             done = time.monotonic() + end_s

@@ -34,7 +34,8 @@ pytest.importorskip('rclpy')
 
 # After the skip: pytest must be imported first, hence E402 and I100.
 from newton_euler_ros.ident.bag import read_joint_states  # noqa: E402, I100
-from ros_harness import domain_id, id_node_cmd, NodeProcess  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
+                         Probe)
 
 pytestmark = pytest.mark.ros
 
@@ -68,50 +69,85 @@ def write_move(path):
     return path
 
 
+def _stamp_ns(msg):
+    return msg.header.stamp.sec * 10 ** 9 + msg.header.stamp.nanosec
+
+
 def test_send_through_the_node_and_record_a_bag(tmp_path):
+    """Send through the node into the simulator; record; stop on Ctrl-C."""
+    import re
+    import signal
+    from sensor_msgs.msg import JointState
+    from newton_euler_ros.sim.scene import scene_dirs
     domain = domain_id(11)
+    # the bundled pick-and-place scene, long enough for a loaded machine
+    bundled = next(path for path in (
+        os.path.join(d, 'puma_pick_and_place.yaml') for d in scene_dirs())
+        if os.path.isfile(path))
+    with open(bundled, encoding='utf-8') as fh:
+        scene = fh.read().replace('duration: 5.0', 'duration: 60.0')
+    assert 'duration: 60.0' in scene
+    (tmp_path / 'scene.yaml').write_text(scene)
     sim_cmd = [os.path.join(os.path.dirname(sys.executable),
                             'robot_sim_node'), '--ros-args',
-               '-p', 'scene:=puma_pick_and_place',
-               # the recorder and the inverse-dynamics node
-               '-p', 'wait_for_subscribers:=2']
+               '-p', f'scene:={tmp_path / "scene.yaml"}',
+               # the recorder, the inverse-dynamics node and the probe
+               '-p', 'wait_for_subscribers:=3']
     node_cmd = id_node_cmd(None, '-p', 'robot_file:=puma560',
                            '-p', 'mode:=gravity', '-r',
                            '~/trajectory_out:=/robot_sim_node/'
                            'joint_trajectory')
     sim = NodeProcess(sim_cmd, domain, str(tmp_path / 'sim.log'))
     node = NodeProcess(node_cmd, domain, str(tmp_path / 'node.log'))
+    probe = Probe(domain, name='send_record_probe')
+    live = probe.collect(JointState, 'joint_states')
     bag = tmp_path / 'recording'
     recorder = subprocess.Popen(
         [os.path.join(os.path.dirname(sys.executable), 'newton-euler'),
-         'record', str(bag), '--duration', str(MOVE + 1.5)],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env=ros_env(domain))
+         'record', str(bag)], stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE, text=True, env=ros_env(domain))
     try:
+        # the robot is up: the simulator has started (it holds t = 0 for
+        # the first command)
+        assert probe.spin_until(lambda: live, 90.0), sim.log() + node.log()
         sent = cli('send', str(write_move(tmp_path / 'move.json')),
                    '--wait', '60', domain=domain, timeout=120)
         assert sent.returncode == 0, sent.stdout + sent.stderr + node.log()
         assert 'sent 201 points for 6 joints to /inverse_dynamics_node/' \
             'trajectory_in' in sent.stdout
-        out, err = recorder.communicate(timeout=60)
+        # the recording goes on until the simulator's stamps are 0.5 s
+        # past the trajectory's end (they lag the wall clock: t = 0 was
+        # held for the first command, and a loaded machine slows it)
+        sec, nanosec = re.search(r'\(stamp (\d+)\.(\d{9})\)',
+                                 sent.stdout).groups()
+        after = int(sec) * 10 ** 9 + int(nanosec) \
+            + int((MOVE + 0.5) * 1e9)
+        assert probe.spin_until(
+            lambda: live and _stamp_ns(live[-1]) >= after, 60.0), sim.log()
+        recorder.send_signal(signal.SIGINT)
+        out, err = recorder.communicate(timeout=30)
     finally:
         if recorder.poll() is None:
             recorder.kill()
+        probe.close()
         status = [node.stop(), sim.stop()]
     assert recorder.returncode == 0, out + err
     assert 'recording /joint_states into' in out and '(reliable)' in out
     assert status == [0, 0], node.log() + sim.log()
-    # the bag is a rosbag2 the identification commands read
+    # the bag is a complete rosbag2 the identification commands read,
+    # with every joint state the simulator published while it recorded
+    # (its stamps are t0 + k 4 ms)
     states = read_joint_states(str(bag), NAMES)
-    assert states.counts['messages'] >= 0.9 * 250 * (MOVE + 1.5)
-    assert np.all(np.diff(states.stamps_ns) > 0)
+    # from t = 0 to 0.5 s past the trajectory's end: over 3 s at 250 Hz
+    assert states.counts['messages'] == states.counts['kept'] >= 700
+    assert np.all(np.diff(states.stamps_ns) == 4_000_000), \
+        'a joint state was lost'
     np.testing.assert_allclose(states.q[0], Q0, atol=1e-12)
     # the node filled the efforts (gravity): sent straight to the
     # simulator, the scene's soft PD alone leaves joint 2 about 0.3 rad
     # below the goal
     goal = np.array(Q0) + STEP
     assert np.abs(states.q[-1] - goal).max() < 0.01, states.q[-1] - goal
-    assert np.abs(states.effort).max() > 1.0
 
 
 def test_send_errors_are_one_line(tmp_path):
