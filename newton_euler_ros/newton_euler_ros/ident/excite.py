@@ -316,7 +316,9 @@ def check_feasible(model, limits, start, period, harmonics):
             f'acceleration limits of {names[j]} ({vmax[j]:.3g} rad/s, '
             f'{amax[j]:.3g} rad/s^2 with the margin): it could swing '
             f'only +-{swing[j]:.3g}; use --period '
-            f'{math.ceil(t_min * 10) / 10:g} or more')
+            f'{math.ceil(t_min * 10) / 10:g} or more (the least that '
+            f'excites at all: a few times that swings wider and '
+            f'identifies better; the default is 10)')
 
 
 def excite(model, period=10.0, harmonics=5, seed=0, start=None,
