@@ -199,3 +199,51 @@ def test_record_errors_are_one_line(tmp_path):
     # nothing was written where nothing could be
     assert not (tmp_path / 'bag').exists()
     assert list(existing.iterdir()) == []
+
+
+def test_record_adapts_to_a_best_effort_driver(tmp_path):
+    """A best-effort publisher is recorded; a wrong type is refused."""
+    import time
+    from rclpy.qos import QoSProfile, ReliabilityPolicy
+    from sensor_msgs.msg import JointState
+    from std_msgs.msg import String
+    domain = domain_id(29)
+    probe = Probe(domain, name='best_effort_driver')
+    pub = probe.node.create_publisher(
+        JointState, 'joint_states',
+        QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+    wrong = probe.node.create_publisher(String, 'not_joint_states', 10)
+    bag = tmp_path / 'best_effort'
+    exe = os.path.join(os.path.dirname(sys.executable), 'newton-euler')
+    recorder = subprocess.Popen(
+        [exe, 'record', str(bag), '--max-messages', '20'],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env=ros_env(domain))
+    try:
+        msg = JointState(name=NAMES, position=Q0, velocity=[0.0] * 6,
+                         effort=[1.0] * 6)
+        stamp = 1_000_000_000
+        end = time.monotonic() + 60.0
+        while recorder.poll() is None and time.monotonic() < end:
+            msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(
+                stamp, 10 ** 9)
+            msg.position[0] = stamp * 1e-9
+            pub.publish(msg)
+            stamp += 10_000_000
+            probe.spin_for(0.01)
+        out, err = recorder.communicate(timeout=10)
+        refused = cli('record', str(tmp_path / 'wrong'), '--topic',
+                      '/not_joint_states', '--wait', '20', domain=domain)
+    finally:
+        if recorder.poll() is None:
+            recorder.kill()
+        probe.close()
+    assert recorder.returncode == 0, out + err
+    assert '(best effort)' in out and 'recorded 20 messages' in out, out
+    states = read_joint_states(str(bag), NAMES, min_samples=1)
+    assert states.counts['messages'] == 20
+    assert refused.returncode == 2
+    assert 'carries std_msgs/msg/String, not sensor_msgs/msg/JointState' \
+        in refused.stderr
+    assert not (tmp_path / 'wrong').exists()
+    del wrong
