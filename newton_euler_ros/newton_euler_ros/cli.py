@@ -250,7 +250,13 @@ def cmd_check(args):
     print(f'  joints: {model.n} ({types}), {_source(model)}')
     print(f'  joint names: {", ".join(model.joint_names)}')
     report = model.info.get('urdf')
-    if report:
+    if report and report.get('tree'):       # the whole tree below base
+        edges = []
+        for jname, link in zip(report['chain'], report['chain_links']):
+            edges.append(f'{report["parent_links"][jname]} -[{jname}]-> '
+                         f'{link}')
+        print(f'  tree below {report["base"]}: {", ".join(edges)}')
+    elif report:
         chain = [report['base']]
         for jname, link in zip(report['chain'], report['chain_links']):
             chain.append(f'-[{jname}]-> {link}')

@@ -22,6 +22,15 @@ for DH arms; ``joint_pre, joint_axis, joint_post`` for general ones, e.g.
 from URDF: each joint is Pre . M(axis, q) . Post, with M a rotation about
 the axis by Rodrigues' formula or a translation along it, and Pre/Post
 products of the elementary operations, all evaluated here).
+
+Trees: ``parents`` (joint j's Pre starts from the link frame of joint
+``parents[j]``, the base for -1), ``mimic`` (None, or (leader, multiplier,
+offset): the joint's angle is multiplier q_leader + offset, and it has no
+coordinate of its own) and ``tool_body`` (the joint whose link carries the
+tool) are read when present; without them the model is a chain.  The
+kinematics are the products along each link's path to the base; a link's
+Jacobian column of coordinate k sums, over the joints on that path moved
+by k, multiplier times the joint's own column.
 The kinematics are products of elementary 4x4 homogeneous matrices, the
 dynamics come from the Lagrangian
 
@@ -172,39 +181,80 @@ def dh_transform(convention, a, alpha, d, theta):
 
 
 # ---------------------------------------------------------------------------
+# the tree: parents, and the coordinate moving each joint
+# ---------------------------------------------------------------------------
+def tree(model):
+    """
+    Return (parents, coordinate, multiplier, offset) per joint, and n.
+
+    Read from the model's public ``parents`` and ``mimic`` (a chain and no
+    mimic joint when it has none).
+    """
+    nb = len(model.joint_types)
+    parents = list(getattr(model, 'parents', None) or range(-1, nb - 1))
+    mimic = list(getattr(model, 'mimic', None) or [None] * nb)
+    independent = [j for j in range(nb) if mimic[j] is None]
+    index = {j: k for k, j in enumerate(independent)}
+    coord, mult, offset = [], [], []
+    for j in range(nb):
+        lead, m, o = (j, 1.0, 0.0) if mimic[j] is None else mimic[j]
+        coord.append(index[lead])
+        mult.append(m)
+        offset.append(o)
+    return parents, coord, mult, offset, len(independent)
+
+
+def path(parents, j):
+    """Joint j and its ancestors (the joints that move its link)."""
+    out = []
+    while j >= 0:
+        out.append(j)
+        j = parents[j]
+    return out
+
+
+def tool_body(model):
+    nb = len(model.joint_types)
+    b = getattr(model, 'tool_body', nb - 1)
+    return -1 if b is None else b
+
+
+# ---------------------------------------------------------------------------
 # forward kinematics
 # ---------------------------------------------------------------------------
 def forward_kinematics(model, q):
     """
     Poses in the base frame, and the joint axes.
 
-    Returns ``(T, axes)``: ``T`` is a list of n + 2 (4, 4) arrays, frame 0,
-    link frames 1..n and the end effector; ``axes[j] = (z, o)`` is the unit
-    direction of joint j+1 and a point on it, in base coordinates.
+    Returns ``(T, axes)``: ``T`` is a list of nb + 2 (4, 4) arrays, frame
+    0, link frames 1..nb and the end effector; ``axes[j] = (z, o)`` is the
+    unit direction of joint j+1 and a point on it, in base coordinates.
     """
     q = np.asarray(q)
-    n = len(model.joint_types)
+    nb = len(model.joint_types)
+    parents, coord, mult, offset, _ = tree(model)
     dt = _dtype(q)
     T = [np.asarray(model.base, dtype=dt)]
     axes = []
     dh = model.convention in (STANDARD, 'modified')
-    for j in range(n):
+    for j in range(nb):
+        qj = mult[j] * q[coord[j]] + offset[j]
         if not dh:
             # general joint: Pre . M(axis, q) . Post; the axis passes
-            # through the origin of Pre's frame
-            P = T[-1] @ ops_transform(model.joint_pre[j])
+            # through the origin of Pre's frame, on its parent's link
+            P = T[parents[j] + 1] @ ops_transform(model.joint_pre[j])
             axes.append((P[:3, :3] @ np.asarray(model.joint_axis[j]),
                          P[:3, 3]))
             T.append(P @ axis_motion(model.joint_types[j],
-                                     model.joint_axis[j], q[j])
+                                     model.joint_axis[j], qj)
                      @ ops_transform(model.joint_post[j]))
             continue
         theta = model.theta[j]
         d = model.d[j]
         if model.joint_types[j] == REVOLUTE:
-            theta = theta + q[j]
+            theta = theta + qj
         else:
-            d = d + q[j]
+            d = d + qj
         A = dh_transform(model.convention, model.a[j], model.alpha[j], d,
                          theta)
         Tj = T[-1] @ A
@@ -215,7 +265,7 @@ def forward_kinematics(model, q):
             # modified: about z of the link's own frame, through its origin
             axes.append((Tj[:3, 2], Tj[:3, 3]))
         T.append(Tj)
-    T.append(T[-1] @ np.asarray(model.tool, dtype=dt))
+    T.append(T[tool_body(model) + 1] @ np.asarray(model.tool, dtype=dt))
     return T, axes
 
 
@@ -225,11 +275,11 @@ def ee_pose(model, q):
 
 
 def com_positions(model, q):
-    """(n, 3) centres of mass in the base frame."""
+    """(nb, 3) centres of mass in the base frame."""
     T, _ = forward_kinematics(model, q)
-    n = len(model.joint_types)
+    nb = len(model.joint_types)
     return np.array([T[j + 1][:3, :3] @ np.asarray(model.com[j])
-                     + T[j + 1][:3, 3] for j in range(n)])
+                     + T[j + 1][:3, 3] for j in range(nb)])
 
 
 def _cross(a, b):
@@ -253,19 +303,44 @@ def com_jacobians(model, q):
     axes, and its rotation R_j (3, 3) in the base frame.
     """
     T, axes = forward_kinematics(model, q)
-    n = len(model.joint_types)
-    dt = _dtype(q)
+    nb = len(model.joint_types)
     out = []
-    for j in range(n):
+    for j in range(nb):
         R = T[j + 1][:3, :3]
         pc = R @ np.asarray(model.com[j]) + T[j + 1][:3, 3]
-        Jv = np.zeros((3, n), dtype=dt)
-        Jw = np.zeros((3, n), dtype=dt)
-        for k in range(j + 1):
-            z, o = axes[k]
-            Jv[:, k], Jw[:, k] = _column(model, k, z, o, pc)
+        Jv, Jw = point_jacobian(model, q, axes, j, pc)
         out.append((Jv, Jw, R))
     return out
+
+
+def point_jacobian(model, q, axes, j, p):
+    """(Jv, Jw), (3, n) each, of point p moving with link j, base axes."""
+    parents, coord, mult, _, n = tree(model)
+    dt = _dtype(q)
+    Jv = np.zeros((3, n), dtype=dt)
+    Jw = np.zeros((3, n), dtype=dt)
+    for k in path(parents, j):
+        z, o = axes[k]
+        v, w = _column(model, k, z, o, p)
+        Jv[:, coord[k]] = Jv[:, coord[k]] + mult[k] * v
+        Jw[:, coord[k]] = Jw[:, coord[k]] + mult[k] * w
+    return Jv, Jw
+
+
+def frame_jacobian(model, q, j, T_local, frame='base'):
+    """
+    Geometric Jacobian (6, n) of a frame fixed to link j at ``T_local``.
+
+    Rows [v; w] of the frame's origin, base axes (or the frame's own with
+    ``frame='link'``); j = -1 for a frame on the base (zero).
+    """
+    T, axes = forward_kinematics(model, q)
+    Tf = T[j + 1] @ np.asarray(T_local)
+    Jv, Jw = point_jacobian(model, q, axes, j, Tf[:3, 3])
+    if frame == 'link':
+        Rf = Tf[:3, :3]
+        return np.vstack([Rf.T @ Jv, Rf.T @ Jw])
+    return np.vstack([Jv, Jw])
 
 
 def ee_jacobian(model, q, frame='base'):
@@ -275,12 +350,8 @@ def ee_jacobian(model, q, frame='base'):
     Base axes (or end-effector axes with ``frame='end_effector'``).
     """
     T, axes = forward_kinematics(model, q)
-    n = len(model.joint_types)
-    pe = T[-1][:3, 3]
-    J = np.zeros((6, n), dtype=_dtype(q))
-    for k in range(n):
-        z, o = axes[k]
-        J[:3, k], J[3:, k] = _column(model, k, z, o, pe)
+    Jv, Jw = point_jacobian(model, q, axes, tool_body(model), T[-1][:3, 3])
+    J = np.vstack([Jv, Jw])
     if frame == 'end_effector':
         Re = T[-1][:3, :3]
         J = np.vstack([Re.T @ J[:3], Re.T @ J[3:]])
@@ -292,7 +363,7 @@ def ee_jacobian(model, q, frame='base'):
 # ---------------------------------------------------------------------------
 def mass_matrix(model, q):
     """D(q) = sum_j m_j Jv^T Jv + Jw^T R I R^T Jw."""
-    n = len(model.joint_types)
+    n = tree(model)[-1]
     D = np.zeros((n, n), dtype=_dtype(q))
     for j, (Jv, Jw, R) in enumerate(com_jacobians(model, q)):
         inertia = R @ np.asarray(model.inertia[j]) @ R.T
@@ -372,16 +443,16 @@ def kinetic_energy(model, q, qd, method='complex'):
     """
     q = np.asarray(q, dtype=float)
     qd = np.asarray(qd, dtype=float)
-    n = len(q)
+    nb = len(model.joint_types)
 
     def poses(x):
         T, _ = forward_kinematics(model, x)
-        return np.array([T[j + 1] for j in range(n)])
+        return np.array([T[j + 1] for j in range(nb)])
 
     Ts = poses(q)
     Tdot = _directional(poses, q, qd, method)
     total = 0.0
-    for j in range(n):
+    for j in range(nb):
         R = Ts[j, :3, :3]
         c = np.asarray(model.com[j])
         vc = Tdot[j, :3, :3] @ c + Tdot[j, :3, 3]

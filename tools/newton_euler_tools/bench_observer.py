@@ -37,7 +37,8 @@ from newton_euler_ros.core import load_robot
 from newton_euler_ros.core import observer as momentum
 from newton_euler_ros.core.dynamics import (coriolis_matrix, gravity_torques,
                                             jacobian, mass_matrix)
-from newton_euler_ros.core.kernels import run_jacobian, run_momentum_terms
+from newton_euler_ros.core.kernels import (F_TOOL, run_jacobian,
+                                           run_momentum_terms)
 from newton_euler_ros.core.observer import (contact_step, external_wrench,
                                             initial_contact, initial_state,
                                             MomentumObserver, observer_step)
@@ -222,10 +223,12 @@ def measure(model, number, repeat):
     ws = obs.ws
     P = model.packed
     terms = np.zeros((3, n))
+    tool = model.frames_array[F_TOOL]
     new_parts = {
         'model terms': lambda: run_momentum_terms(P, q, qd, ws.ws, ws.cw,
                                                   terms),
-        'J': lambda: run_jacobian(P, q, False, ws.ws, ws.frames, obs.J),
+        'J': lambda: run_jacobian(P, q, model.tool_body, tool, False, ws.ws,
+                                  ws.frames, obs.J),
     }
     ows = old.obs.ws
     old_parts = {

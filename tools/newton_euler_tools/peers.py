@@ -251,3 +251,115 @@ class PinocchioUrdf:
                                  pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
         return {'tau': tau, 'D': D, 'C': C, 'g': g, 'J': J.copy(),
                 'tau_wrench': tau + J.T @ wrench}
+
+
+class PinocchioTree:
+    """
+    Pinocchio's own reading of a whole URDF tree, as our tree model.
+
+    ``pin.buildModelFromUrdf(path, mimic=True)`` (fixed base at the root
+    link): mimic joints follow their leaders as in our model.  Joints are
+    matched by name (Pinocchio orders a link's children by joint name, we
+    by document order); continuous joints take (cos q, sin q).  ``full``
+    is the same URDF without mimic coupling (every joint a coordinate),
+    with ``G`` (nv_full x n) and ``offset`` mapping our coordinates to its
+    own: Pinocchio 4.1's ``computeCoriolisMatrix`` is not the Christoffel
+    matrix on a mimic model (C qd differs from the velocity-product
+    torques there), so C is taken as G^T C_full(G q + o, G qd) G.
+    """
+
+    def __init__(self, path, model):
+        import pinocchio as pin
+        self.pin = pin
+        self.ours = model
+        self.model = pin.buildModelFromUrdf(path, mimic=True)
+        self.data = self.model.createData()
+        self.full = pin.buildModelFromUrdf(path)
+        self.full_data = self.full.createData()
+        ids = {self.model.names[i]: i for i in range(1, self.model.njoints)}
+        self.joints = [self.model.joints[ids[name]]
+                       for name in model.joint_names]
+        self.iv = np.array([j.idx_v for j in self.joints])
+        fids = {self.full.names[i]: i for i in range(1, self.full.njoints)}
+        self.full_joints = [self.full.joints[fids[name]]
+                            for name in model.moving_joints]
+        self.G = np.zeros((self.full.nv, model.n))
+        self.offset = np.zeros(self.full.nv)
+        coord = {b: k for k, b in enumerate(model.independent)}
+        for b, joint in enumerate(self.full_joints):
+            lead, mult, off = ((b, 1.0, 0.0) if model.mimic[b] is None
+                               else model.mimic[b])
+            self.G[joint.idx_v, coord[lead]] = mult
+            self.offset[joint.idx_v] = off
+
+    @staticmethod
+    def _put(out, joint, value):
+        if joint.nq == 2:       # continuous: cos, sin
+            out[joint.idx_q] = math.cos(value)
+            out[joint.idx_q + 1] = math.sin(value)
+        else:
+            out[joint.idx_q] = value
+
+    def config(self, q):
+        """Pinocchio's configuration vector of our coordinates."""
+        out = self.pin.neutral(self.model)
+        for k, joint in enumerate(self.joints):
+            self._put(out, joint, q[k])
+        return out
+
+    def full_config(self, q):
+        """Return the mimic-free model's configuration: every angle."""
+        x = self.G @ q + self.offset
+        out = self.pin.neutral(self.full)
+        for joint in self.full_joints:
+            self._put(out, joint, x[joint.idx_v])
+        return out
+
+    def vector(self, x):
+        """Return our coordinates (rates, torques) in Pinocchio's order."""
+        out = np.zeros(self.model.nv)
+        out[self.iv] = x
+        return out
+
+    def frame(self, link):
+        return self.model.getFrameId(link, self.pin.FrameType.BODY)
+
+    def terms(self, q, qd, qdd, links=()):
+        """tau, D, C, g, qdd of D^-1 (tau - C qd - g), J of ``links``."""
+        pin = self.pin
+        m, d, iv = self.model, self.data, self.iv
+        x, v, a = self.config(q), self.vector(qd), self.vector(qdd)
+        tau = pin.rnea(m, d, x, v, a)[iv].copy()
+        Dm = pin.crba(m, d, x).copy()
+        Dm = (np.triu(Dm) + np.triu(Dm, 1).T)[np.ix_(iv, iv)]
+        g = pin.computeGeneralizedGravity(m, d, x)[iv].copy()
+        bias = pin.rnea(m, d, x, v, 0 * v)[iv].copy()
+        xf, vf = self.full_config(q), self.G @ qd
+        Cf = pin.computeCoriolisMatrix(self.full, self.full_data, xf, vf)
+        Df = pin.crba(self.full, self.full_data, xf).copy()
+        Df = np.triu(Df) + np.triu(Df, 1).T
+        D = self.G.T @ Df @ self.G
+        out = {'tau': tau, 'D': D, 'D mimic': Dm, 'g': g,
+               'C': self.G.T @ Cf @ self.G,
+               'fd': np.linalg.solve(D, tau - bias)}
+        pin.computeJointJacobians(m, d, x)
+        pin.updateFramePlacements(m, d)
+        for link in links:
+            for axes, ref in (('base', pin.ReferenceFrame.LOCAL_WORLD_ALIGNED),
+                              ('link', pin.ReferenceFrame.LOCAL)):
+                J = pin.getFrameJacobian(m, d, self.frame(link), ref)
+                J = np.reshape(J, (6, -1))
+                out[f'J {link} {axes}'] = J[:, iv].copy()
+        return out
+
+    def regressor(self, q, qd, qdd):
+        """pin.computeJointTorqueRegressor, rows and body columns ours."""
+        pin = self.pin
+        m, d = self.model, self.data
+        Y = pin.computeJointTorqueRegressor(
+            m, d, self.config(q), self.vector(qd), self.vector(qdd))
+        ids = {m.names[i]: i for i in range(1, m.njoints)}
+        cols = np.concatenate([np.arange(10 * (ids[name] - 1),
+                                         10 * ids[name])
+                               for name in self.ours.moving_joints])
+        return Y[np.ix_(self.iv, cols)]

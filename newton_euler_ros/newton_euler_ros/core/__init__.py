@@ -26,7 +26,7 @@ momentum observer.
 from .drives import Drives
 from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        end_effector_pose, forward_dynamics,
-                       forward_dynamics_batch, gravity_torques,
+                       forward_dynamics_batch, frame_pose, gravity_torques,
                        gravity_torques_batch, inverse_dynamics,
                        inverse_dynamics_batch, jacobian, link_poses,
                        mass_matrix, mass_matrix_batch, mass_matrix_condition,
@@ -50,7 +50,8 @@ __all__ = [
     'NewtonEulerError', 'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
     'RobotModel', 'Workspace', 'bundled_robots', 'coriolis_matrix',
     'coriolis_matrix_batch', 'end_effector_pose', 'forward_dynamics',
-    'forward_dynamics_batch', 'gravity_torques', 'gravity_torques_batch',
+    'forward_dynamics_batch', 'frame_pose', 'gravity_torques',
+    'gravity_torques_batch',
     'inspect_robot', 'inverse_dynamics', 'inverse_dynamics_batch',
     'jacobian', 'link_poses', 'load_robot', 'make_model', 'mass_matrix',
     'mass_matrix_batch', 'mass_matrix_condition', 'pose_matrix',

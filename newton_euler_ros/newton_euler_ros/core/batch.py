@@ -103,7 +103,9 @@ def forward_dynamics_batch(model, Q, QD, TAU, W=None, wrench_frame='base', *,
     :func:`forward_dynamics` (articulated-body) for each row; (m, n).
 
     Raises :class:`NotPositiveDefiniteError` for the first row where D is
-    singular, naming the row and the joint.
+    singular, naming the row and the joint.  A model with mimic joints
+    takes the Cholesky path of
+    :func:`~newton_euler_ros.core.dynamics.forward_dynamics`, row by row.
     """
     ws, Q, QD = _states(model, ws, Q, QD)
     m = Q.shape[0]
@@ -111,7 +113,31 @@ def forward_dynamics_batch(model, Q, QD, TAU, W=None, wrench_frame='base', *,
     TAU = matrix('TAU', TAU, ws.n, m)
     W, mode = _wrenches(W, wrench_frame, m)
     QDD = out_array(out, Q.shape)
-    _check(K.run_forward_dynamics_batch(
+    row = K.run_forward_dynamics_batch(
         model.packed, Q, QD, TAU, W, K.flags(gravity, velocity_products, mode),
-        ws.ws, ws.aw, QDD, ws.status), ws, model, Q)
+        ws.ws, ws.aw, QDD, ws.status)
+    if row >= 0 and ws.status[0] == K.MIMIC:    # coupled joints: Cholesky
+        _solve_rows(model, ws, Q, QD, TAU, W,
+                    K.flags(gravity, velocity_products, mode), QDD)
+        return QDD
+    _check(row, ws, model, Q)
     return QDD
+
+
+def _solve_rows(model, ws, Q, QD, TAU, W, flags, QDD):
+    """Solve D qdd = tau - bias per row: D by CRBA, bias by Newton-Euler."""
+    n = ws.n
+    D = np.empty((n, n))
+    bias = np.empty(n)
+    for k in range(Q.shape[0]):
+        code = K.run_inverse_dynamics(model.packed, Q[k], QD[k], ws.zeros,
+                                      W[k], flags, ws.ws, bias)
+        if code < 0:
+            code = K.run_mass_matrix_crba(model.packed, Q[k], ws.ws, D)
+        if code >= 0:
+            raise status_error(code, row=k)
+        rhs = TAU[k] - bias
+        bad = K.cholesky_solve(D, rhs, ws.chol, QDD[k])
+        if bad >= 0:
+            raise status_error(K.SINGULAR + bad, model=model, q=Q[k], ws=ws,
+                               row=k)

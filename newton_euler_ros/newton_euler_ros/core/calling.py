@@ -53,6 +53,7 @@ F8 = types.float64
 VEC = types.Array(F8, 1, 'C')
 MAT = types.Array(F8, 2, 'C')
 PACKED = types.Array(F8, 2, 'C', readonly=True)
+TARGET = types.Array(F8, 1, 'C', readonly=True)
 INT = types.int64
 BOOL = types.boolean
 
@@ -100,7 +101,7 @@ def workspace(model, ws):
     if ws is None:
         return model.default_workspace
     if type(ws) is not Workspace or ws.n != model.n \
-            or ws.dtype != np.float64:
+            or ws.nb != model.nb or ws.dtype != np.float64:
         raise DynamicsInputError(
             f'ws must be a float64 Workspace for a model of {model.n} '
             f'joints, got {ws!r}')
@@ -210,7 +211,7 @@ def status_error(code, values=(), names=INPUTS, precision='float64',
     singular mass matrix; ``row`` the row of a batch.
     """
     at = '' if row is None else f' for row {row}'
-    if code >= K.SINGULAR:
+    if K.SINGULAR <= code < K.MIMIC:
         err = not_positive_definite(model, q, code - K.SINGULAR, ws)
         if row is None:
             return err

@@ -79,13 +79,15 @@ from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
                       first_singular_pivot, foreign_workspace, FORWARD_DYNAMICS_METHODS, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
                       out_array, PACKED, Refused, status_error, strict_entry,
-                      VEC, vector, workspace, WRENCH_FRAMES, wrench_mode)
-from .errors import DynamicsInputError
+                      VEC, vector, workspace, wrench_mode)
+from .frames import (end_effector_pose, frame_pose, jacobian, link_poses,
+                     link_wrench_rows, wrench_torques)
 
 __all__ = [
     'CORIOLIS_METHODS', 'FORWARD_DYNAMICS_METHODS', 'MASS_MATRIX_METHODS',
     'coriolis_matrix', 'coriolis_matrix_batch', 'end_effector_pose',
     'first_singular_pivot', 'forward_dynamics', 'forward_dynamics_batch',
+    'frame_pose',
     'gravity_torques', 'gravity_torques_batch', 'inverse_dynamics',
     'inverse_dynamics_batch', 'jacobian', 'link_poses', 'mass_matrix',
     'mass_matrix_batch', 'mass_matrix_condition', 'solve_mass_matrix',
@@ -105,8 +107,10 @@ _coriolis = strict_entry(K.run_coriolis_matrix, PACKED, VEC, VEC, BOOL, MAT,
                          MAT, MAT, MAT)
 _aba = strict_entry(K.run_forward_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
                     MAT, MAT, VEC)
-_jac = strict_entry(K.run_jacobian, PACKED, VEC, BOOL, MAT, MAT, MAT)
-_poses = strict_entry(K.run_link_poses, PACKED, VEC, MAT, MAT)
+_tau_links = strict_entry(K.run_inverse_dynamics_links, PACKED, VEC, VEC,
+                          VEC, VEC, MAT, INT, MAT, VEC)
+_aba_links = strict_entry(K.run_forward_dynamics_links, PACKED, VEC, VEC,
+                          VEC, VEC, MAT, INT, MAT, MAT, VEC)
 
 assert (K.GRAVITY, K.VELOCITY, K.WRENCH_SHIFT) == (1, 2, 2)  # literals below
 
@@ -129,10 +133,17 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
     q, qd, qdd : (n,) array_like
         Joint positions, velocities, accelerations (rad or m, and their
         rates); ``None`` (the default for qd and qdd) means zeros.
-    wrench : (6,) array_like or None
-        [f; n], N and N m, exerted by the end effector.
-    wrench_frame : str
-        ``'base'`` or ``'end_effector'``: the axes of ``wrench``.
+    wrench : (6,) array_like, dict or None
+        [f; n], N and N m, exerted by the end effector; or wrenches at
+        links, ``{frame name: [f; n]}`` (several at once: a force-torque
+        sensor at each wrist), each exerted by that frame on its
+        environment, the moment about its origin (see
+        :mod:`~newton_euler_ros.core.frames`).
+    wrench_frame : str or dict
+        ``'base'`` or ``'end_effector'``: the axes of an end-effector
+        ``wrench``; for wrenches at links ``'base'`` or ``'link'`` (the
+        frame's own axes), for all, or a dict per frame name (default
+        ``'base'``).
     gravity, velocity_products : bool
         Set False to leave that term out (it is then not computed at all).
     ws : Workspace, optional
@@ -150,6 +161,9 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
     flags = 3 if gravity is True and velocity_products is True else (
         (1 if gravity else 0) | (2 if velocity_products else 0))
     if wrench is not None:
+        if type(wrench) is dict:
+            return _tau_at_links(model, ws, q, qd, qdd, wrench, wrench_frame,
+                                 flags, out)
         flags |= wrench_mode(wrench, wrench_frame) << 2
     try:
         tau = np.empty(w.n) if out is None else out
@@ -178,6 +192,23 @@ def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
     code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
     if code >= 0:
         raise status_error(code, (q, qd, qdd, wrench))
+    return tau
+
+
+def _tau_at_links(model, ws, q, qd, qdd, wrenches, wrench_frame, flags,
+                  out):
+    """Newton-Euler with wrenches at links (``kernels`` ``fext`` rows)."""
+    ws = workspace(model, ws)
+    n = ws.n
+    q = vector('q', q, n)
+    qd = ws.zeros if qd is None else vector('qd', qd, n)
+    qdd = ws.zeros if qdd is None else vector('qdd', qdd, n)
+    fext = link_wrench_rows(model, q, wrenches, wrench_frame, ws)
+    tau = out_array(out, (n,))
+    code = _tau_links(model.packed, q, qd, qdd, ws.zero_wrench, fext,
+                      flags | K.LINK_WRENCHES, ws.ws, tau)
+    if code >= 0:
+        raise status_error(code, (q, qd, qdd))
     return tau
 
 
@@ -293,75 +324,6 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
     return C
 
 
-def jacobian(model, q, frame='base', *, ws=None, out=None):
-    """
-    Geometric Jacobian J(q), (6, n), of the end-effector origin.
-
-    Rows are [linear velocity; angular velocity] such that
-    ``[v; w] = J(q) qd``, in base-frame axes (``frame='base'``) or
-    end-effector axes (``frame='end_effector'``).  Cost: O(n).
-    """
-    ws = workspace(model, ws)
-    if frame not in WRENCH_FRAMES:
-        raise DynamicsInputError(
-            f"frame must be 'base' or 'end_effector', got {frame!r}")
-    n = ws.n
-    q = vector('q', q, n)
-    J = out_array(out, (6, n))
-    code = _jac(model.packed, q, frame == 'end_effector', ws.ws, ws.frames, J)
-    if code >= 0:
-        raise status_error(code, (q,))
-    return J
-
-
-def wrench_torques(model, q, wrench, wrench_frame='base', *, ws=None):
-    """
-    J(q)^T F_e: the joint forces that balance an end-effector wrench.
-
-    Computed from the Jacobian (virtual work); :func:`inverse_dynamics`
-    applies the same wrench as f_{n+1}, tau_{n+1} in its backward pass, and
-    the two agree to round-off.
-    """
-    F = vector('wrench', wrench, 6)
-    i = K.first_nonfinite(F)
-    if i >= 0:
-        raise status_error(3 * K.NONFINITE + i, (None, None, None, F))
-    J = jacobian(model, q, wrench_frame, ws=ws)
-    return J.T @ F
-
-
-def _poses_array(model, q, ws):
-    ws = workspace(model, ws)
-    q = vector('q', q, ws.n)
-    code = _poses(model.packed, q, ws.ws, ws.frames)
-    if code >= 0:
-        raise status_error(code, (q,))
-    return ws.frames
-
-
-def end_effector_pose(model, q, *, ws=None):
-    """4x4 pose of the end-effector frame in the base frame."""
-    frames = _poses_array(model, q, ws)
-    T = np.eye(4)
-    T[:3, :3] = frames[-1, :9].reshape(3, 3)
-    T[:3, 3] = frames[-1, 9:]
-    return T
-
-
-def link_poses(model, q, *, ws=None):
-    """
-    Poses of frames 0..n and of the end effector in the base frame.
-
-    Returns an (n + 2, 4, 4) array of homogeneous transforms.
-    """
-    frames = _poses_array(model, q, ws)
-    T = np.zeros((frames.shape[0], 4, 4))
-    T[:, :3, :3] = frames[:, :9].reshape(-1, 3, 3)
-    T[:, :3, 3] = frames[:, 9:]
-    T[:, 3, 3] = 1.0
-    return T
-
-
 def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                      method='aba', gravity=True, velocity_products=True,
                      ws=None, out=None):
@@ -375,11 +337,21 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
     (relative to the conditioning of D).  Either raises
     :class:`NotPositiveDefiniteError` naming the first joint at which D
     is not positive definite (a joint that moves no mass or inertia).
+    A model with mimic joints always takes the Cholesky path: the
+    articulated-body algorithm does not apply to coupled joints (as in
+    Pinocchio, whose ``aba`` refuses them).  ``wrench`` and
+    ``wrench_frame`` as in :func:`inverse_dynamics` (wrenches at links
+    too).
     """
     flags = 3 if gravity is True and velocity_products is True else (
         (1 if gravity else 0) | (2 if velocity_products else 0))
-    if wrench is not None:
+    if wrench is not None and type(wrench) is not dict:
         flags |= wrench_mode(wrench, wrench_frame) << 2
+    if method == 'aba' and type(wrench) is dict:
+        if model.n == model.nb:
+            return _aba_at_links(model, ws, q, qd, tau, wrench, wrench_frame,
+                                 flags, out)
+        method = 'cholesky'
     if method == 'aba':
         w = model.default_workspace if ws is None else ws
         try:
@@ -393,7 +365,8 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
         except AttributeError:
             foreign_workspace(model, ws)
             raise
-        return _aba_converted(model, ws, q, qd, tau, wrench, flags, out)
+        return _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame,
+                              flags, out)
     if method != 'cholesky':
         raise bad_method(method, FORWARD_DYNAMICS_METHODS)
     ws = workspace(model, ws)
@@ -410,7 +383,7 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                              tau - bias, ws=ws, out=qdd)
 
 
-def _aba_converted(model, ws, q, qd, tau, wrench, flags, out):
+def _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame, flags, out):
     """Call the articulated-body entry again, arguments converted once."""
     ws = workspace(model, ws)
     n = ws.n
@@ -418,9 +391,29 @@ def _aba_converted(model, ws, q, qd, tau, wrench, flags, out):
     w = ws.zero_wrench if wrench is None else vector('wrench', wrench, 6)
     qdd = out_array(out, (n,))
     code = _aba(model.packed, q, qd, tau, w, flags, ws.ws, ws.aw, qdd)
+    if code == K.MIMIC:     # coupled joints: the Cholesky path
+        return forward_dynamics(model, q, qd, tau, wrench, wrench_frame,
+                                method='cholesky', gravity=bool(flags & 1),
+                                velocity_products=bool(flags & 2), ws=ws,
+                                out=qdd)
     if code >= 0:
         raise status_error(code, (q, qd, tau, w), FD_INPUTS, model=model,
                            q=q, ws=ws)
+    return qdd
+
+
+def _aba_at_links(model, ws, q, qd, tau, wrenches, wrench_frame, flags, out):
+    """Call the articulated-body entry with wrenches at links."""
+    ws = workspace(model, ws)
+    n = ws.n
+    q, qd, tau = vector('q', q, n), vector('qd', qd, n), vector('tau', tau, n)
+    fext = link_wrench_rows(model, q, wrenches, wrench_frame, ws)
+    qdd = out_array(out, (n,))
+    code = _aba_links(model.packed, q, qd, tau, ws.zero_wrench, fext,
+                      flags | K.LINK_WRENCHES, ws.ws, ws.aw, qdd)
+    if code >= 0:
+        raise status_error(code, (q, qd, tau), FD_INPUTS, model=model, q=q,
+                           ws=ws)
     return qdd
 
 

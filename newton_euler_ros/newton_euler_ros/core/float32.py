@@ -233,6 +233,8 @@ class Float32Dynamics:
         bad = K.run_forward_dynamics(self.packed, q32, qd32, tau32, w32,
                                      K.flags(True, True, mode), self._ws.ws,
                                      self._ws.aw, qdd)
+        if bad == K.MIMIC:      # coupled joints: D qdd = tau - bias
+            bad = self._solve(q32, qd32, tau32, w32, mode, qdd)
         if bad >= K.SINGULAR:
             raise _not_positive_definite(self.model, np.asarray(q, float),
                                          bad - K.SINGULAR,
@@ -241,6 +243,21 @@ class Float32Dynamics:
             _raise(bad, (q32, qd32, tau32, w32), (q, qd, tau, wrench),
                    _FD_INPUTS)
         return qdd
+
+    def _solve(self, q32, qd32, tau32, w32, mode, qdd):
+        """Solve D qdd = tau - bias by Cholesky, in float32 (mimic joints)."""
+        n = self.n
+        ws = self._ws
+        bias = np.empty(n, dtype=_F32)
+        bad = K.run_inverse_dynamics(self.packed, q32, qd32, ws.zeros, w32,
+                                     K.flags(True, True, mode), ws.ws, bias)
+        if bad >= 0:
+            return bad
+        D = np.empty((n, n), dtype=_F32)
+        if K.run_mass_matrix_crba(self.packed, q32, ws.ws, D) >= 0:
+            return K.OVERFLOW
+        bad = K.cholesky_solve(D, tau32 - bias, ws.chol, qdd)
+        return -1 if bad < 0 else K.SINGULAR + bad
 
     def gravity_torques(self, q, *, out=None):
         """g(q) in float32: the joint torques that hold the arm still."""

@@ -82,7 +82,7 @@ class HighPrecisionModel:
             links, frames = compile_arrays(model, _MpNumbers)
             self.links = np.array(
                 [list(row) for row in links],
-                dtype=object).reshape(model.n, K.L_WIDTH)
+                dtype=object).reshape(model.nb, K.L_WIDTH)
             self.frames = np.array(frames, dtype=object)
 
     def _vec(self, x, size):
@@ -98,15 +98,20 @@ class HighPrecisionModel:
         mode = K.WRENCH_NONE if wrench is None else (
             K.WRENCH_BASE if wrench_frame == 'base' else K.WRENCH_EE)
         with mpmath.workdps(self.dps):
-            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            ws = self._ws()
             tau = np.empty(n, dtype=object)
             qv = self._vec(q, n)
             qdv = self._vec(qd, n)
             _MP.joint_trig(self.links, self.frames, qv, ws)
             _MP.recursion(self.links, self.frames, qdv, qdv,
-                          self._vec(qdd, n), self._vec(wrench, 6), gravity,
-                          velocity_products, mode, ws, tau)
+                          self._vec(qdd, n), self._vec(wrench, 6), ws,
+                          gravity, velocity_products, mode, False, ws, tau)
         return tau
+
+    def _ws(self):
+        """Return a fresh (nb, W_WIDTH) workspace of mpf zeros."""
+        return np.full((self.model.nb, K.W_WIDTH), mpmath.mpf(0),
+                       dtype=object)
 
     def mass_matrix(self, q, method='newton_euler'):
         """
@@ -119,7 +124,7 @@ class HighPrecisionModel:
         if method not in MASS_MATRIX_METHODS:
             raise _bad_method(method)
         with mpmath.workdps(self.dps):
-            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            ws = self._ws()
             D = np.empty((n, n), dtype=object)
             qv = self._vec(q, n)
             if method == 'crba':
@@ -148,11 +153,12 @@ class HighPrecisionModel:
         if method not in CORIOLIS_METHODS:
             raise _bad_method(method, CORIOLIS_METHODS)
         with mpmath.workdps(self.dps):
-            ws = np.empty((n, K.W_WIDTH), dtype=object)
+            ws = self._ws()
             C = np.empty((n, n), dtype=object)
             qv, qdv = self._vec(q, n), self._vec(qd, n)
             if method == 'composite':
-                cw = np.empty((n + 1, K.CW_WIDTH), dtype=object)
+                cw = np.full((self.model.nb + 1, K.CW_WIDTH), mpmath.mpf(0),
+                             dtype=object)
                 _MP.coriolis_matrix_composite(self.links, self.frames, qv,
                                               qdv, ws, cw, C)
                 return C
@@ -181,13 +187,14 @@ class HighPrecisionModel:
                 x = mpmath.lu_solve(mpmath.matrix(D.tolist()),
                                     mpmath.matrix(rhs))
                 return np.array([x[i] for i in range(n)], dtype=object)
-            ws = np.empty((n, K.W_WIDTH), dtype=object)
-            aw = np.empty((n + 1, K.A_WIDTH), dtype=object)
+            ws = self._ws()
+            aw = np.full((self.model.nb + 1, K.A_WIDTH), mpmath.mpf(0),
+                         dtype=object)
             qdd = np.empty(n, dtype=object)
             _MP.articulated_body(self.links, self.frames, self._vec(q, n),
                                  self._vec(qd, n), self._vec(tau, n),
-                                 self._vec(wrench, 6), True, True, mode, ws,
-                                 aw, qdd)
+                                 self._vec(wrench, 6), ws, True, True, mode,
+                                 False, ws, aw, qdd)
         return qdd
 
 

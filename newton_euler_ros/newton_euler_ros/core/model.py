@@ -13,11 +13,20 @@
 # limitations under the License.
 
 """
-The constant robot model: a serial chain of revolute and prismatic joints.
+The constant robot model: a tree (or chain) of revolute and prismatic joints.
 
 A :class:`RobotModel` is immutable after construction (its arrays are
 read-only).  Per-call scratch memory lives in a separate
 :class:`~newton_euler_ros.core.workspace.Workspace`.
+
+The tree.  The model's moving joints are numbered parent first:
+``model.parents[j] < j`` is the joint whose link carries joint j (-1: the
+base), and a chain is the tree with ``parents[j] = j - 1``
+(:mod:`~newton_euler_ros.core.tree`).  Mimic joints (``model.mimic``)
+follow a leader and are not coordinates: ``model.joint_names`` lists the
+n independent joints, ``model.moving_joints`` all nb moving joints, and
+the per-joint arrays (types, placements, masses, limits) run over the
+moving joints.  Below, "frame j-1" is the frame of joint j's parent.
 
 One joint model for every source.  Joint j carries link frame j-1 to link
 frame j as
@@ -53,11 +62,15 @@ Frames and conventions (SI units throughout):
   Gravity, wrenches in base axes and the Jacobian are expressed here.
 - *frame 0*: the frame the first joint's placement starts from, at pose
   ``base`` in the base frame (identity for URDF robots).
-- *link frame j* (j = 1..n): the frame of link j, in which its centre of
+- *link frame j* (j = 1..nb): the frame of link j, in which its centre of
   mass and inertia are given: for standard DH at the distal end of link
   j, for modified DH and URDF at joint j.
-- *end-effector frame*: at pose ``tool`` in link frame n (for URDF, the
-  tip link's frame).
+- *end-effector frame*: at pose ``tool`` in the link frame of joint
+  ``tool_body`` (for URDF, the tip link's frame; a tree with several tips
+  has none, ``tool_body`` None).
+- *named frames* (``link_frames``, from URDF): every link of the tree,
+  as (the joint whose link it is fixed to, -1 for the base; its pose in
+  that link frame, or in frame 0).
 """
 from dataclasses import dataclass, field
 import functools
@@ -67,6 +80,10 @@ import numpy as np
 
 from . import kernels as K
 from .inertia import inertia_matrix, merge_bodies  # noqa: F401 (re-export)
+from .transforms import (axis_frame, evaluate_ops, Float64Math,  # noqa: F401
+                         matrix_op, OPS, ops_matrix, pose_matrix, rpy_matrix)
+from .tree import (chain_parents, check_tree, compile_arrays,  # noqa: F401
+                   coordinates)
 from .workspace import Workspace
 
 REVOLUTE = 'revolute'
@@ -77,25 +94,6 @@ URDF = 'urdf'
 DH_CONVENTIONS = (STANDARD, MODIFIED)
 
 
-def rpy_matrix(roll, pitch, yaw):
-    """Rotation of ROS roll-pitch-yaw angles: Rz(yaw) Ry(pitch) Rx(roll)."""
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr]])
-
-
-def pose_matrix(xyz=(0.0, 0.0, 0.0), rpy=(0.0, 0.0, 0.0)):
-    """4x4 homogeneous transform from a translation and ROS rpy angles."""
-    T = np.eye(4)
-    T[:3, :3] = rpy_matrix(*rpy)
-    T[:3, 3] = xyz
-    return T
-
-
 def _readonly(x):
     x = np.array(x, dtype=np.float64)
     x.setflags(write=False)
@@ -103,169 +101,6 @@ def _readonly(x):
 
 
 # ---------------------------------------------------------------------------
-# elementary transforms, in any number type
-# ---------------------------------------------------------------------------
-class Float64Math:
-    """The number type of the kernels: float64 with ``math``."""
-
-    cos = staticmethod(math.cos)
-    sin = staticmethod(math.sin)
-    sqrt = staticmethod(math.sqrt)
-    num = staticmethod(float)
-
-
-OPS = {'tx': 1, 'ty': 1, 'tz': 1, 'rx': 1, 'ry': 1, 'rz': 1, 'xyz': 3,
-       'rpy': 3, 'matrix': 12}
-
-
-def _identity(m):
-    z, o = m.num(0.0), m.num(1.0)
-    return [[o, z, z], [z, o, z], [z, z, o]], [z, z, z]
-
-
-def _mul(A, B):
-    return [[A[i][0] * B[0][k] + A[i][1] * B[1][k] + A[i][2] * B[2][k]
-             for k in range(3)] for i in range(3)]
-
-
-def _apply(A, x):
-    return [A[i][0] * x[0] + A[i][1] * x[1] + A[i][2] * x[2]
-            for i in range(3)]
-
-
-def _compose(X, Y):
-    """(R1, p1) . (R2, p2) = (R1 R2, p1 + R1 p2)."""
-    (R1, p1), (R2, p2) = X, Y
-    t = _apply(R1, p2)
-    return _mul(R1, R2), [p1[i] + t[i] for i in range(3)]
-
-
-def _transpose(A):
-    return [[A[k][i] for k in range(3)] for i in range(3)]
-
-
-def _elementary(op, args, m):
-    """(R, p) of one operation, in the number type of ``m``."""
-    R, p = _identity(m)
-    if op in ('tx', 'ty', 'tz'):
-        p['xyz'.index(op[1])] = m.num(args[0])
-    elif op in ('rx', 'ry', 'rz'):
-        c, s = m.cos(m.num(args[0])), m.sin(m.num(args[0]))
-        i = 'xyz'.index(op[1])
-        a, b = (i + 1) % 3, (i + 2) % 3
-        R[a][a], R[a][b], R[b][a], R[b][b] = c, -s, s, c
-    elif op == 'xyz':
-        p = [m.num(x) for x in args]
-    elif op == 'rpy':
-        for angle, axis in zip(args[::-1], 'zyx'):
-            R = _mul(R, _elementary('r' + axis, (angle,), m)[0])
-    elif op == 'matrix':
-        R = [[m.num(args[3 * i + k]) for k in range(3)] for i in range(3)]
-        p = [m.num(x) for x in args[9:]]
-    else:
-        raise ValueError(f'unknown transform operation {op!r}')
-    return R, p
-
-
-def evaluate_ops(ops, m=Float64Math):
-    """Compose a list of elementary operations into (R, p)."""
-    X = _identity(m)
-    for op in ops:
-        X = _compose(X, _elementary(op[0], op[1:], m))
-    return X
-
-
-def matrix_op(T):
-    """Return the operation ``('matrix', ...)`` of a 4x4 transform."""
-    T = np.asarray(T, dtype=np.float64)
-    return ('matrix',) + tuple(float(x) for x in T[:3, :3].ravel()) + tuple(
-        float(x) for x in T[:3, 3])
-
-
-def ops_matrix(ops):
-    """4x4 float64 transform of a list of operations."""
-    R, p = evaluate_ops(ops)
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = p
-    return T
-
-
-def axis_frame(axis, m=Float64Math):
-    """
-    Return a rotation A with A z = axis (a unit vector).
-
-    Exact for +-x, +-y and +-z.
-
-    For axis_z >= 0 it is the rotation about z x axis (Rodrigues, written
-    with k = 1 / (1 + z)); for axis_z < 0, A(-axis) Rx(pi), which keeps
-    1 + z away from zero.
-    """
-    x, y, z = (m.num(v) for v in axis)
-    o = m.num(1.0)
-    if z >= 0:
-        k = o / (o + z)
-        return [[o - x * x * k, -(x * y * k), x],
-                [-(x * y * k), o - y * y * k, y],
-                [-x, -y, z]]
-    k = o / (o - z)
-    return [[o - x * x * k, x * y * k, x],
-            [-(x * y * k), -(o - y * y * k), y],
-            [x, -y, z]]
-
-
-def compile_arrays(model, m=Float64Math):
-    """
-    Compile a model into its kernel arrays, in the number type of ``m``.
-
-    Returns ``(links, frames)`` as nested lists (``links``: n rows of
-    ``K.L_WIDTH``; ``frames``: ``K.F_ROWS`` rows of 12).  See the module
-    docstring for the kernel frames: row j holds joint j's placement
-    P_j = B_{j-1} Pre_j A_j (B_{j-1} = A_{j-1}^T Post_{j-1}, the pose of
-    link frame j-1 in kernel frame j-1), the link's mass, centre of mass
-    and inertia re-expressed in kernel frame j, and B_j itself (for
-    poses of the link frames).
-    """
-    n = model.n
-    z = m.num(0.0)
-    B_prev = _identity(m)
-    links = []
-    for j in range(n):
-        A = axis_frame(model.joint_axis[j], m)
-        pre = evaluate_ops(model.joint_pre[j], m)
-        P = _compose(_compose(B_prev, pre), (A, [z, z, z]))
-        B = _compose((_transpose(A), [z, z, z]),
-                     evaluate_ops(model.joint_post[j], m))
-        RB, pB = B
-        c = [m.num(v) for v in model.com[j]]
-        t = _apply(RB, c)
-        com = [t[i] + pB[i] for i in range(3)]
-        inertia = [[m.num(v) for v in row] for row in model.inertia[j]]
-        inertia = _mul(_mul(RB, inertia), _transpose(RB))
-        row = [z] * K.L_WIDTH
-        row[K.L_TYPE] = m.num(0.0 if model.joint_types[j] == REVOLUTE
-                              else 1.0)
-        row[K.L_R:K.L_R + 9] = [x for r in P[0] for x in r]
-        row[K.L_P:K.L_P + 3] = P[1]
-        row[K.L_MASS] = m.num(model.mass[j])
-        row[K.L_COM:K.L_COM + 3] = com
-        row[K.L_INERTIA:K.L_INERTIA + 9] = [x for r in inertia for x in r]
-        row[K.L_BODY:K.L_BODY + 9] = [x for r in RB for x in r]
-        row[K.L_BODY + 9:K.L_BODY + 12] = pB
-        links.append(row)
-        B_prev = B
-    tool = _compose(B_prev, evaluate_ops([matrix_op(model.tool)], m))
-    base = evaluate_ops([matrix_op(model.base)], m)
-    frames = [[z] * 12 for _ in range(K.F_ROWS)]
-    frames[K.F_CONST][:len(K.CONSTANTS)] = [m.num(c) for c in K.CONSTANTS]
-    for row, (R, p) in ((K.F_BASE, base), (K.F_TOOL, tool)):
-        frames[row][:9] = [x for r in R for x in r]
-        frames[row][9:] = p
-    g = [m.num(v) for v in model.gravity]
-    frames[K.F_GRAV][:3] = _apply(_transpose(base[0]), g)
-    return links, frames
-
-
 def dh_ops(convention, a, alpha, d, theta):
     """Pre and Post operations of one DH row (see the module docstring)."""
     if convention == STANDARD:
@@ -276,7 +111,7 @@ def dh_ops(convention, a, alpha, d, theta):
 @dataclass(frozen=True, eq=False)
 class RobotModel:
     """
-    A serial manipulator: joints, inertial parameters, gravity, frames.
+    A robot: a tree of joints, inertial parameters, gravity, frames.
 
     Build one with :func:`make_model` (DH), :func:`make_chain` (general
     joints, as URDF gives them),
@@ -287,21 +122,30 @@ class RobotModel:
     ----------
     name : str
     convention : ``'standard'``, ``'modified'`` (DH) or ``'urdf'``
-    joint_names : tuple of n str
-    joint_types : tuple of n ``'revolute'`` / ``'prismatic'``
+    joint_names : tuple of n str, the independent joints (coordinates)
+        in tree order (given to the constructors: all nb moving joints)
+    moving_joints : tuple of nb str, every moving joint, mimic ones too
+    parents : tuple of nb int, the parent joint of each (-1: the base)
+    mimic : tuple of nb, None or (leader joint index, multiplier, offset)
+    joint_types : tuple of nb ``'revolute'`` / ``'prismatic'``
     a, alpha, d, theta : (n,) DH parameters (m, rad, m, rad) of a DH
         model; the joint variable adds to ``theta`` (revolute) or ``d``
         (prismatic).  None for other models.
-    joint_pre, joint_post : tuple of n tuples of operations; joint_axis :
-        (n, 3) unit axes (see the module docstring).  Derived from the DH
+    joint_pre, joint_post : tuple of nb tuples of operations; joint_axis :
+        (nb, 3) unit axes (see the module docstring).  Derived from the DH
         table for DH models.
-    mass : (n,) kg
-    com : (n, 3) centre of mass in link frame j, m
-    inertia : (n, 3, 3) about the centre of mass, link-frame axes, kg m^2
+    mass : (nb,) kg
+    com : (nb, 3) centre of mass in link frame j, m
+    inertia : (nb, 3, 3) about the centre of mass, link-frame axes, kg m^2
     gravity : (3,) gravitational acceleration in the base frame, m/s^2
     base : (4, 4) pose of frame 0 in the base frame
-    tool : (4, 4) pose of the end-effector frame in link frame n
-    limits : tuple of n dicts (keys among lower, upper, velocity, effort)
+    tool : (4, 4) pose of the end-effector frame in link frame
+        ``tool_body`` (frame 0 for -1)
+    tool_body : int or None: the joint whose link carries the end
+        effector (the last one of a chain); None: no end effector
+    link_frames : dict, link name -> (joint index or -1, (4, 4) pose in
+        that joint's link frame or in frame 0): the URDF's links
+    limits : tuple of nb dicts (keys among lower, upper, velocity, effort)
     info : dict of source details (e.g. URDF link names); not dynamics
     links_array, frames_array : read-only copies for the kernels
     packed : both in one read-only array, as the kernels' entry points
@@ -328,12 +172,33 @@ class RobotModel:
     joint_axis: np.ndarray = None
     joint_post: tuple = None
     info: dict = None
+    parents: tuple = None
+    mimic: tuple = None
+    tool_body: object = 'last'
+    link_frames: dict = None
+    moving_joints: tuple = field(init=False)
     links_array: np.ndarray = field(init=False, repr=False)
     frames_array: np.ndarray = field(init=False, repr=False)
     packed: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
-        n = len(self.joint_names)
+        names = tuple(self.joint_names)
+        n = nb = len(names)
+        parents, mimic = check_tree(
+            names, chain_parents(nb) if self.parents is None
+            else self.parents, self.mimic)
+        independent, _ = coordinates(mimic)
+        tool_body = nb - 1 if self.tool_body == 'last' else self.tool_body
+        if tool_body is not None and not -1 <= int(tool_body) < nb:
+            raise ValueError(f'tool_body must be -1 (the base), a joint '
+                             f'index below {nb} or None, got {tool_body!r}')
+        for key, value in (
+                ('moving_joints', names), ('parents', parents),
+                ('mimic', mimic),
+                ('joint_names', tuple(names[j] for j in independent)),
+                ('tool_body', None if tool_body is None else int(tool_body)),
+                ('link_frames', _frames(self.link_frames, nb))):
+            object.__setattr__(self, key, value)
         if self.convention in DH_CONVENTIONS:
             pre, post = zip(*(dh_ops(self.convention, self.a[j],
                                      self.alpha[j], self.d[j], self.theta[j])
@@ -346,7 +211,7 @@ class RobotModel:
             object.__setattr__(self, 'info', {})
         links, frames = compile_arrays(self)
         object.__setattr__(self, 'links_array',
-                           _readonly(np.reshape(links, (n, K.L_WIDTH))))
+                           _readonly(np.reshape(links, (nb, K.L_WIDTH))))
         object.__setattr__(self, 'frames_array', _readonly(frames))
         object.__setattr__(self, 'packed', _readonly(
             K.pack(self.links_array, self.frames_array)))
@@ -363,8 +228,24 @@ class RobotModel:
 
     @property
     def n(self):
-        """Return the number of joints (degrees of freedom)."""
+        """Return the number of coordinates (independent joints)."""
         return len(self.joint_names)
+
+    @property
+    def nb(self):
+        """Return the number of moving joints (bodies), mimic ones too."""
+        return len(self.moving_joints)
+
+    @property
+    def independent(self):
+        """Return the index (in ``moving_joints``) of each coordinate."""
+        return coordinates(self.mimic)[0]
+
+    @property
+    def is_chain(self):
+        """Tell whether joint j's parent is j - 1 for all j, no mimic."""
+        return (self.parents == chain_parents(self.nb)
+                and self.n == self.nb)
 
     @property
     def total_mass(self):
@@ -386,17 +267,34 @@ class RobotModel:
 
     def replace(self, **changes):
         """Return a copy with some fields changed (e.g. ``gravity=[0, 0, 0]``)."""
-        keys = ['name', 'convention', 'joint_names', 'joint_types', 'a',
+        keys = ['name', 'convention', 'joint_types', 'a',
                 'alpha', 'd', 'theta', 'mass', 'com', 'inertia', 'gravity',
-                'base', 'tool', 'limits', 'info']
+                'base', 'tool', 'limits', 'info', 'tool_body']
         if not self.is_dh:
-            keys += ['joint_pre', 'joint_axis', 'joint_post']
+            keys += ['joint_pre', 'joint_axis', 'joint_post', 'parents',
+                     'mimic', 'link_frames']
         fields = {k: getattr(self, k) for k in keys}
+        fields['joint_names'] = self.moving_joints
         fields.update(changes)
         if fields['convention'] in DH_CONVENTIONS:
             return make_model(**fields)
         return make_chain(**{k: v for k, v in fields.items()
                              if k not in ('a', 'alpha', 'd', 'theta')})
+
+
+def _frames(link_frames, nb):
+    """Return the named frames, checked: name -> (joint, read-only 4x4)."""
+    out = {}
+    for name, (body, pose) in (link_frames or {}).items():
+        body = int(body)
+        if not -1 <= body < nb:
+            raise ValueError(f'link frame {name!r}: joint index {body} is '
+                             f'not -1 (the base) or below {nb}')
+        pose = _readonly(pose)
+        if pose.shape != (4, 4):
+            raise ValueError(f'link frame {name!r}: the pose must be 4x4')
+        out[str(name)] = (body, pose)
+    return out
 
 
 def _check_types(joint_types):
@@ -425,9 +323,10 @@ def _common(n, name, joint_names, joint_types, mass, com, inertia, gravity,
 
 def make_model(name, convention, joint_names, joint_types, a, alpha, d,
                theta, mass, com, inertia, gravity=(0.0, 0.0, -9.81),
-               base=None, tool=None, limits=None, info=None):
+               base=None, tool=None, limits=None, info=None,
+               tool_body='last'):
     """
-    Build a DH :class:`RobotModel` from plain sequences.
+    Build a DH :class:`RobotModel` (a chain) from plain sequences.
 
     No validation of physical plausibility: :func:`load_robot` does that for
     files.
@@ -441,6 +340,7 @@ def make_model(name, convention, joint_names, joint_types, a, alpha, d,
         convention=convention,
         a=_readonly(np.reshape(a, n)), alpha=_readonly(np.reshape(alpha, n)),
         d=_readonly(np.reshape(d, n)), theta=_readonly(np.reshape(theta, n)),
+        tool_body=tool_body,
         **_common(n, name, joint_names, joint_types, mass, com, inertia,
                   gravity, base, tool, limits, info))
 
@@ -448,13 +348,18 @@ def make_model(name, convention, joint_names, joint_types, a, alpha, d,
 def make_chain(name, joint_names, joint_types, joint_pre, joint_axis,
                mass, com, inertia, joint_post=None, gravity=(0.0, 0.0, -9.81),
                base=None, tool=None, limits=None, info=None,
-               convention=URDF):
+               convention=URDF, parents=None, mimic=None, tool_body='last',
+               link_frames=None):
     """
-    Build a :class:`RobotModel` from general joints (URDF-style).
+    Build a :class:`RobotModel` from general joints (URDF-style), a tree.
 
+    ``joint_names`` lists every moving joint, parent first;
     ``joint_pre[j]`` is a sequence of operations (see :data:`OPS`), or a
-    4x4 matrix; ``joint_axis[j]`` a nonzero 3-vector (normalized here);
-    ``joint_post`` defaults to identities.
+    4x4 matrix, placing joint j in its parent's link frame;
+    ``joint_axis[j]`` a nonzero 3-vector (normalized here);
+    ``joint_post`` defaults to identities.  ``parents`` (default: a
+    chain), ``mimic``, ``tool_body`` and ``link_frames`` as the
+    attributes of :class:`RobotModel`.
     """
     n = len(joint_names)
     _check_types(joint_types)
@@ -483,7 +388,8 @@ def make_chain(name, joint_names, joint_types, joint_pre, joint_axis,
         convention=convention, a=None, alpha=None, d=None, theta=None,
         joint_pre=tuple(ops(x) for x in joint_pre),
         joint_axis=_readonly(axes),
-        joint_post=tuple(ops(x) for x in post),
+        joint_post=tuple(ops(x) for x in post), parents=parents,
+        mimic=mimic, tool_body=tool_body, link_frames=link_frames,
         **_common(n, name, joint_names, joint_types, mass, com, inertia,
                   gravity, base, tool, limits, info))
 
@@ -550,13 +456,21 @@ def with_payload(model, mass, com, inertia):
 
     The payload (``mass`` kg, centre of mass ``com`` in end-effector axes
     and origin, ``inertia`` 3x3 about its centre of mass in end-effector
-    axes) is merged into the last link by the parallel-axis theorem, so the
-    dynamics cost nothing extra.
+    axes) is merged into the link carrying the end effector (the last one
+    of a chain) by the parallel-axis theorem, so the dynamics cost nothing
+    extra.  A model without an end effector (a tree with several tips)
+    raises ValueError.
     """
     if not mass >= 0.0:
         raise ValueError(f'payload mass must be >= 0, got {mass}')
+    b = model.tool_body
+    if b is None:
+        raise ValueError(f'{model.name}: the model has no end effector (a '
+                         f'tree with several tips): load it with a tip link')
+    if b < 0:       # an end effector fixed to the base carries nothing
+        return model
     m, c, I_new = merge_bodies([
-        (model.mass[-1], model.com[-1], model.inertia[-1], np.eye(3),
+        (model.mass[b], model.com[b], model.inertia[b], np.eye(3),
          np.zeros(3)),
         (mass, com, inertia, model.tool[:3, :3], model.tool[:3, 3])])
     if m == 0.0:
@@ -564,5 +478,5 @@ def with_payload(model, mass, com, inertia):
     masses = np.array(model.mass)
     coms = np.array(model.com)
     inertias = np.array(model.inertia)
-    masses[-1], coms[-1], inertias[-1] = m, c, I_new
+    masses[b], coms[b], inertias[b] = m, c, I_new
     return model.replace(mass=masses, com=coms, inertia=inertias)

@@ -72,8 +72,8 @@ from .calling import (F8, MAT, out_array, PACKED, Refused, status_error,
                       strict_entry, VEC, vector, workspace)
 from .dynamics import jacobian
 from .errors import DynamicsInputError
-from .kernels import (cholesky_solve, NONFINITE, run_jacobian,
-                      run_momentum_terms, SIZE)
+from .kernels import (cholesky_solve, F_ROWS, F_TOOL, F_TREE, NONFINITE,
+                      run_jacobian, run_momentum_terms, SIZE, T_TOOL)
 from .kernels._jit import ENTRY, uses_kernels
 from .workspace import Workspace
 
@@ -208,7 +208,9 @@ def _wrench(P, q, r, damping, ws, Ts, J, A, y, F):
     A kernel status code for q (or SIZE + 1 for r), else -1 with F the
     wrench, or zeros when the solve fails.
     """
-    code = run_jacobian(P, q, False, ws, Ts, J)
+    frames = P[P.shape[0] - F_ROWS:]        # the end effector's Jacobian
+    code = run_jacobian(P, q, int(frames[F_TREE, T_TOOL]), frames[F_TOOL],
+                        False, ws, Ts, J)
     if code >= 0:
         return code
     if r.shape[0] != J.shape[1] or F.shape[0] != 6:

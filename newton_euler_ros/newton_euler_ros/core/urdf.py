@@ -13,12 +13,14 @@
 # limitations under the License.
 
 """
-Robots from URDF: the chain from a base link to a tip link as a model.
+Robots from URDF: the whole tree below a base link, or the chain to a tip.
 
-What a URDF model means here (see the README, "Robots from URDF"):
+Without ``tip`` the model is the whole tree below ``base`` (default: the
+URDF's root link), mimic joints following their leaders
+(:mod:`~newton_euler_ros.core.urdf_whole`: the joint order, the mimic
+semantics).  With ``tip``, the chain from ``base`` to ``tip``:
 
-- The chain runs from ``base`` (default: the URDF's root link) to ``tip``
-  (default: the single leaf below the base).  Its ``revolute``,
+- The chain runs from ``base`` to ``tip``.  Its ``revolute``,
   ``continuous`` and ``prismatic`` joints are the model's joints, in
   chain order; a ``floating`` or ``planar`` joint on the chain is an
   error.
@@ -59,7 +61,9 @@ from .errors import RobotFileError, RobotFileWarning
 from .inertia import format_moments, Note, principal_moments, triangle_note
 from .model import make_chain, pose_matrix, PRISMATIC, REVOLUTE, rpy_matrix
 from .text import clip, read_text
-from .urdf_tree import attached, chain_ends, combine
+from .urdf_tree import (attached, chain_ends, check_link, combine,
+                        mimic_cycle)
+from .urdf_whole import tree_model
 from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
 
 MAX_BYTES = 16 * 1024 * 1024
@@ -347,6 +351,11 @@ def parse_urdf(text, label='robot_description'):
         if joint.mimic and joint.mimic[0] not in joints:
             raise src.error(f'joint {joint.name!r} <mimic> joint',
                             f'no joint named {_short(joint.mimic[0])!r}')
+    cycle = mimic_cycle(joints)
+    if cycle:
+        raise src.error(f'joint {cycle[0]!r} <mimic> joint',
+                        'mimic joints form a cycle: '
+                        + _short(' -> '.join(cycle), 300))
     roots = [n for n, lk in links.items() if lk.parent_joint is None]
     if not roots:
         raise RobotFileError(f'{label}: the links form a cycle (every link '
@@ -493,13 +502,23 @@ def _chain_limits(joints, moving):
 def urdf_model(text, label='robot_description', base=None, tip=None,
                gravity=(0.0, 0.0, -9.81)):
     """
-    Build the chain model of URDF text; return (model, warnings, report).
+    Build the model of URDF text; return (model, warnings, report).
 
-    ``report`` describes what was made of the tree: the chain's links and
-    joints, the merged fixed joints, the lumped subtrees and the frames
-    rigidly attached to the base and to the tip (for wrenches).
+    Without ``tip``: the whole tree below ``base`` (``urdf_whole``).
+    With it, the chain; ``report`` describes what was made of the tree:
+    the chain's links and joints, the merged fixed joints, the lumped
+    subtrees and the frames rigidly attached to the base and to the tip
+    (for wrenches).
     """
     name, root, links, joints = parse_urdf(text, label)
+    if tip is None:
+        base = root if base is None else base
+        check_link(label, links, 'base', base)
+        return tree_model(
+            name, label, links, joints, base, gravity,
+            lambda names: _chain_limits(joints, names),
+            lambda names: read_drives(_parse(text, _Source(label)), names,
+                                      label))
     base, tip, chain = chain_ends(label, links, joints, root, base, tip)
     moving = _moving_joints(label, joints, chain, base, tip)
     pre, merged, tool = _placements(joints, chain, moving)
@@ -536,7 +555,10 @@ def inspect_urdf(text_or_path, base=None, tip=None, label=None,
 
 def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):
     """
-    Load a URDF, given as XML text or a file path, as a chain model.
+    Load a URDF, given as XML text or a file path, as a model.
+
+    Without ``tip``: the whole tree below ``base`` (default: the root
+    link); with it, the chain from ``base`` to ``tip``.
 
     ``gravity`` is in the base link's axes (URDF does not carry it).
 

@@ -105,6 +105,31 @@ def combine(parts, links):
                          for lname, T, _ in parts])
 
 
+def check_link(label, links, role, lname):
+    """Raise naming the closest links when ``lname`` is not in the tree."""
+    if lname is not None and lname not in links:
+        close = difflib.get_close_matches(str(lname), list(links), n=3,
+                                          cutoff=0.5)
+        hint = (' (closest: ' + ', '.join(map(repr, close)) + ')'
+                if close else
+                f' (links: {_short(", ".join(links), 300)})')
+        raise RobotFileError(f'{label}: {role} link {_short(lname)!r} is '
+                             f'not in the URDF{hint}')
+
+
+def mimic_cycle(joints):
+    """Return the first cycle of mimic joints as a list of names, or None."""
+    for start in joints:
+        seen = [start]
+        name = start
+        while joints[name].mimic is not None:
+            name = joints[name].mimic[0]
+            if name in seen:
+                return seen[seen.index(name):] + [name]
+            seen.append(name)
+    return None
+
+
 def chain_ends(label, links, joints, root, base, tip):
     """
     Return (base, tip, joint names from base to tip) of a URDF tree.
@@ -114,14 +139,7 @@ def chain_ends(label, links, joints, root, base, tip):
     """
     base = root if base is None else base
     for role, lname in (('base', base), ('tip', tip)):
-        if lname is not None and lname not in links:
-            close = difflib.get_close_matches(str(lname), list(links), n=3,
-                                              cutoff=0.5)
-            hint = (' (closest: ' + ', '.join(map(repr, close)) + ')'
-                    if close else
-                    f' (links: {_short(", ".join(links), 300)})')
-            raise RobotFileError(f'{label}: {role} link {_short(lname)!r} is '
-                                 f'not in the URDF{hint}')
+        check_link(label, links, role, lname)
     if tip is None:
         leaves = _leaves_below(links, joints, base)
         if len(leaves) != 1:

@@ -35,18 +35,23 @@ class Workspace:
 
     def __init__(self, model, dtype=np.float64):
         n = model.n
-        self.n = n
+        nb = model.nb
+        self.n = n              # coordinates (independent joints)
+        self.nb = nb            # moving joints (bodies), mimic ones too
         self.dtype = np.dtype(dtype)
-        self.ws = np.zeros((n, K.W_WIDTH), dtype)
+        self.ws = np.zeros((nb, K.W_WIDTH), dtype)
         self.scratch = np.zeros((3, n), dtype)
-        self.frames = np.zeros((n + 2, 12), dtype)
+        self.frames = np.zeros((nb + 2, 12), dtype)
         self.chol = np.zeros((n, n), dtype)
-        self.aw = np.zeros((n + 1, K.A_WIDTH), dtype)
-        self.cw = np.zeros((n + 1, K.CW_WIDTH), dtype)
+        self.aw = np.zeros((nb + 1, K.A_WIDTH), dtype)
+        self.cw = np.zeros((nb + 1, K.CW_WIDTH), dtype)
+        self.fext = np.zeros((nb, 6), dtype)
         self.zeros = np.zeros(n, dtype)
         self.zero_wrench = np.zeros(6, dtype)
         self.status = np.zeros(1, np.int64)
 
     def __repr__(self):
         """Return e.g. ``Workspace(n=6, float64)``."""
+        if self.nb != self.n:
+            return f'Workspace(n={self.n}, nb={self.nb}, {self.dtype})'
         return f'Workspace(n={self.n}, {self.dtype})'

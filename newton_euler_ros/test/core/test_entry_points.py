@@ -40,7 +40,9 @@ def args():
     return model, {
         'P': model.packed, 'q': q, 'qd': q.copy(), 'qdd': q.copy(),
         'tau': q.copy(), 'wrench': np.zeros(6), 'flags': 3, 'crba': True,
-        'composite': True, 'in_ee_axes': False, 'ws': ws.ws, 'aw': ws.aw,
+        'composite': True, 'local': False, 'body': n - 1,
+        'target': model.frames_array[K.F_TOOL], 'fext': ws.fext,
+        'ws': ws.ws, 'aw': ws.aw,
         'cw': ws.cw, 'scratch': ws.scratch, 'Ts': ws.frames,
         'D': np.empty((n, n)), 'C': np.empty((n, n)), 'J': np.empty((6, n)),
         'terms': np.empty((3, n)),

@@ -37,7 +37,7 @@ from newton_euler_ros.core import float32 as float32_module
 from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core.float32 import Float32Dynamics
 from newton_euler_ros.core.highprec import HighPrecisionModel, relative_error
-from newton_euler_ros.core.model import pose_matrix, rpy_matrix
+from newton_euler_ros.core.model import make_chain, pose_matrix, rpy_matrix
 import numba
 from numba.core import types as nbtypes
 import numpy as np
@@ -225,40 +225,49 @@ def _float64_variables(mod):
 
 
 def _run_every_kernel(mod, model, dtype):
-    n = model.n
+    n, nb = model.n, model.nb
+    fd_ok = mod.MIMIC if nb != n else -1     # ABA refuses mimic joints
     f = dtype
     links = model.links_array.astype(f)
     frames = model.frames_array.astype(f)
     q = np.linspace(-1.0, 1.0, n).astype(f)
-    ws = np.zeros((n, mod.W_WIDTH), f)
+    ws = np.zeros((nb, mod.W_WIDTH), f)
     scratch = np.zeros((3, n), f)
     w = np.arange(6).astype(f)
+    fext = np.ones((nb, 6), f)
     tau = np.zeros(n, f)
     M = np.zeros((n, n), f)
     for mode in (mod.WRENCH_NONE, mod.WRENCH_BASE, mod.WRENCH_EE):
         mod.joint_trig(links, frames, q, ws)
-        mod.recursion(links, frames, q, q, q, w, True, True, mode, ws, tau)
+        mod.recursion(links, frames, q, q, q, w, fext, True, True, mode,
+                      True, ws, tau)
     Q = np.tile(q, (3, 1))
     TAU = np.zeros((3, n), f)
     W = np.zeros((3, 6), f)
     status = np.zeros(1, np.int64)
     P = mod.pack(links, frames)
-    aw = np.zeros((n + 1, mod.A_WIDTH), f)
-    cw = np.zeros((n + 1, mod.CW_WIDTH), f)
-    Ts = np.zeros((n + 2, 12), f)
+    aw = np.zeros((nb + 1, mod.A_WIDTH), f)
+    cw = np.zeros((nb + 1, mod.CW_WIDTH), f)
+    Ts = np.zeros((nb + 2, 12), f)
     J = np.zeros((6, n), f)
+    target = frames[mod.F_TOOL].copy()
     for mode in (mod.WRENCH_NONE, mod.WRENCH_BASE, mod.WRENCH_EE):
         flags = mod.flags(True, True, mode)
         assert mod.run_inverse_dynamics(P, q, q, q, w, flags, ws, tau) == -1
         assert mod.run_forward_dynamics(P, q, q, q, w, flags, ws, aw,
-                                        tau) == -1
+                                        tau) == fd_ok
+        flags = mod.flags(True, True, mode, True)
+        assert mod.run_inverse_dynamics_links(P, q, q, q, w, fext, flags, ws,
+                                              tau) == -1
+        assert mod.run_forward_dynamics_links(P, q, q, q, w, fext, flags, ws,
+                                              aw, tau) == fd_ok
     assert mod.run_gravity_torques(P, q, ws, tau) == -1
     assert mod.run_mass_matrix_crba(P, q, ws, M) == -1
     for method in (True, False):
         assert mod.run_mass_matrix(P, q, method, ws, scratch, M) == -1
         assert mod.run_coriolis_matrix(P, q, q, method, ws, cw, scratch,
                                        M) == -1
-    assert mod.run_jacobian(P, q, True, ws, Ts, J) == -1
+    assert mod.run_jacobian(P, q, nb - 1, target, True, ws, Ts, J) == -1
     assert mod.run_link_poses(P, q, ws, Ts) == -1
     terms = np.zeros((3, n), f)
     assert mod.run_momentum_terms(P, q, q, ws, cw, terms) == -1
@@ -266,29 +275,46 @@ def _run_every_kernel(mod, model, dtype):
     assert mod.run_inverse_dynamics_batch(P, Q, Q, Q, W, flags, ws, TAU,
                                           status) == -1
     assert mod.run_forward_dynamics_batch(P, Q, Q, Q, W, flags, ws, aw, TAU,
-                                          status) == -1
+                                          status) == (0 if nb != n else -1)
     MM = np.zeros((3, n, n), f)
     assert mod.run_mass_matrix_batch(P, Q, ws, MM, status) == -1
     assert mod.run_gravity_torques_batch(P, Q, ws, TAU, status) == -1
     assert mod.run_coriolis_matrix_batch(P, Q, Q, ws, cw, MM, status) == -1
-    YY = np.zeros((3, n, 14 * n), f)
+    YY = np.zeros((3, n, 10 * nb + 4 * n), f)
     assert mod.run_regressor_batch(P, Q, Q, Q, True, f(0.02), ws,
-                                   np.zeros((n, 6), f),
-                                   np.zeros((10 * n, 6), f), YY,
+                                   np.zeros((nb, 6), f),
+                                   np.zeros((10 * nb, 6), f), YY,
                                    status) == -1
     assert mod.mass_matrix_columns(links, frames, q, ws, scratch, M) == -1
     D = M.copy()
     assert mod.mass_matrix_crba(links, frames, q, ws, M) == -1
     assert mod.coriolis_matrix_columns(links, frames, q, q, ws, scratch,
                                        M) == -1
-    Ts = np.zeros((n + 2, 12), f)
+    Ts = np.zeros((nb + 2, 12), f)
     mod.forward_kinematics(links, frames, q, ws, Ts)
     J = np.zeros((6, n), f)
-    mod.jacobian(links, frames, q, True, ws, Ts, J)
+    mod.jacobian(links, frames, q, nb - 1, target, True, ws, Ts, J)
     x = np.zeros(n, f)
-    assert mod.cholesky_solve(D, q, np.zeros((n, n), f), x) == -1
+    assert mod.cholesky_solve(D + 10 * np.eye(n, dtype=f), q,
+                              np.zeros((n, n), f), x) == -1
     mod.round_into(q, x)
     assert mod.check_finite(q, q, q, w) == -1     # Float32Dynamics calls it
+
+
+def _tree_with_mimic():
+    """Return a small tree: branches on the base and on body 1, a mimic."""
+    nb = 5
+    rng = np.random.default_rng(7)
+    return make_chain(
+        'tree', [f'j{k}' for k in range(nb)],
+        ['revolute', 'prismatic', 'revolute', 'revolute', 'prismatic'],
+        [[('xyz', *rng.uniform(-0.3, 0.3, 3)),
+          ('rpy', *rng.uniform(-1, 1, 3))] for _ in range(nb)],
+        rng.normal(size=(nb, 3)), rng.uniform(0.5, 2.0, nb),
+        rng.uniform(-0.1, 0.1, (nb, 3)),
+        [np.diag(rng.uniform(0.01, 0.02, 3)) for _ in range(nb)],
+        parents=[-1, 0, 1, 1, -1], mimic=[None, None, None, (0, -0.7, 0.2),
+                                          None])
 
 
 @pytest.fixture(scope='module')
@@ -301,6 +327,8 @@ def test_float32_kernels_have_no_float64_anywhere(fresh_kernels):
     for convention in ('standard', 'modified'):
         _run_every_kernel(fresh_kernels, _chain(4, 1, convention),
                           np.float32)
+    # and a tree with branch points and a mimic joint, every code path
+    _run_every_kernel(fresh_kernels, _tree_with_mimic(), np.float32)
     found, missing = _float64_variables(fresh_kernels)
     assert not missing, f'kernels never compiled for float32: {missing}'
     assert not found, found

@@ -308,9 +308,20 @@ def test_total_mass_is_every_link_that_rides_on_the_chain():
     assert model.limits[2] == {'effort': 5.0, 'velocity': 3.0}
 
 
-def test_default_tip_needs_a_single_leaf():
-    with pytest.raises(RobotFileError, match=r'2 leaves \(finger, tool0\)'):
-        arm()
+def test_without_a_tip_the_whole_tree_loads():
+    # base_link carries l1 (j1); l2 (j2) carries l3 (j3) and the finger
+    # (grip): depth first in document order, grip after j3's subtree
+    tree = arm(base='world')
+    assert tree.joint_names == ('j1', 'j2', 'j3', 'grip')
+    assert tree.parents == (-1, 0, 1, 1)
+    assert tree.tool_body is None          # two tips: finger and tool0
+    assert tree.info['urdf']['tip'] is None
+    assert tree.info['urdf']['lumped'] == []
+    assert tree.link_frames['tool0'][0] == 2
+    assert tree.link_frames['base_link'][0] == -1
+    # the total mass is the same as the chain's, which lumps the finger
+    assert tree.total_mass == pytest.approx(
+        arm(base='world', tip='tool0').total_mass)
     assert arm(tip='l3').info['urdf']['lumped'] == ['grip', 'flange']
 
 
@@ -619,8 +630,12 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
     assert 'merged fixed joints: mount, flange' in out
     assert 'lumped off-chain subtrees (at zero position): grip' in out
     assert 'massless' not in out          # tool0 is a frame
-    code, out, err = run_cli('check', str(path))
-    assert code != 0 and err.count('\n') == 1 and '2 leaves' in err
+    code, out, err = run_cli('check', str(path))     # the whole tree
+    assert code == 0, err
+    assert ('tree below world: world -[mount]-> base_link, base_link -[j1]-> '
+            'l1, l1 -[j2]-> l2, l2 -[j3]-> l3, l3 -[flange]-> tool0, '
+            'l2 -[grip]-> finger') in out
+    assert 'joints: 4 (RPRP)' in out
 
 
 def test_float32_runs_the_same_kernels_on_a_urdf_model():

@@ -28,8 +28,9 @@ file                   what it holds
 ``crba.py``            D(q) by the composite-rigid-body algorithm
 ``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
 ``aba.py``             qdd by the articulated-body algorithm
-``kinematics.py``      joint placements, link poses, spatial inertias and
-                       the Jacobian
+``kinematics.py``      the tree (parents, branch points, mimic joints'
+                       coordinates), joint placements, link poses, spatial
+                       inertias and the Jacobian of any link
 ``spatial.py``         3-vector and 6x6 helpers; the one force carry
                        (``force_to_parent``) and the one motion carry
                        (``motion_to_child``)
@@ -71,34 +72,38 @@ from .cholesky import cholesky_solve
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, C_HALF,
-                     C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC, CW_F1,
-                     CW_F2, CW_G, CW_I, CW_OW, CW_RW, CW_S, CW_SD, CW_V,
-                     CW_WIDTH, F_BASE, F_CONST, F_GRAV, F_ROWS, F_TOOL, flags,
-                     GRAVITY, L_BODY, L_COM, L_INERTIA, L_MASS, L_P, L_R,
-                     L_TYPE, L_WIDTH, NONFINITE, OVERFLOW, pack, SINGULAR,
-                     SIZE, VELOCITY, W_CT, W_DD, W_F, W_N, W_P, W_R, W_ST,
-                     W_WIDTH, WRENCH_BASE, WRENCH_EE, WRENCH_NONE,
-                     WRENCH_SHIFT)
+from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH,
+                     C_HALF, C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC,
+                     CW_BCA, CW_F1, CW_F2, CW_G, CW_I, CW_ICA, CW_OW, CW_RW,
+                     CW_S, CW_SD, CW_V, CW_WIDTH, F_BASE, F_CONST, F_GRAV,
+                     F_ROWS, F_TOOL, F_TREE, flags, GRAVITY, L_BODY, L_COM,
+                     L_INERTIA, L_LEAD, L_MASS, L_MULT, L_OFFSET, L_P,
+                     L_PARENT, L_R, L_STORE, L_TYPE, L_WIDTH, LINK_WRENCHES,
+                     MIMIC, NONFINITE, OVERFLOW, pack, SINGULAR, SIZE,
+                     T_BRANCHED, T_NQ, T_TOOL, VELOCITY, W_ACC, W_CT, W_DD,
+                     W_F, W_N, W_P, W_R, W_ST, W_WIDTH, W_X, WRENCH_BASE,
+                     WRENCH_BITS, WRENCH_EE, WRENCH_NONE, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
                            momentum_terms, recursion, unit_columns)
 from .status import check_finite, first_nonfinite, round_into
 
 __all__ = [
-    'A_C', 'A_D', 'A_IA', 'A_PA', 'A_U', 'A_UU', 'A_V', 'A_WIDTH',
+    'A_A', 'A_C', 'A_D', 'A_IA', 'A_PA', 'A_U', 'A_UU', 'A_V', 'A_WIDTH',
     'articulated_body', 'C_HALF', 'C_ONE', 'C_ZERO', 'check_finite',
     'cholesky_solve', 'CONSTANTS', 'coriolis_matrix_columns',
-    'coriolis_matrix_composite', 'CS_BC', 'CS_H', 'CS_IC', 'CW_F1',
-    'CW_F2', 'CW_G', 'CW_I', 'CW_OW', 'CW_RW', 'CW_S', 'CW_SD', 'CW_V',
-    'CW_WIDTH', 'ENTRY', 'F_BASE', 'F_CONST', 'F_GRAV', 'F_ROWS', 'F_TOOL',
-    'first_nonfinite', 'flags', 'forward_kinematics', 'GRAVITY',
-    'jacobian', 'joint_trig', 'L_BODY', 'L_COM', 'L_INERTIA', 'L_MASS',
-    'L_P', 'L_R', 'L_TYPE', 'L_WIDTH', 'mass_matrix_columns',
-    'mass_matrix_crba', 'momentum_terms', 'NONFINITE', 'OVERFLOW', 'pack',
-    'recursion',
-    'round_into', 'SINGULAR', 'SIZE', 'unit_columns', 'VELOCITY',
-    'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
-    'WRENCH_BASE', 'WRENCH_EE', 'WRENCH_NONE', 'WRENCH_SHIFT',
+    'coriolis_matrix_composite', 'CS_BC', 'CS_H', 'CS_IC', 'CW_BCA',
+    'CW_F1', 'CW_F2', 'CW_G', 'CW_I', 'CW_ICA', 'CW_OW', 'CW_RW', 'CW_S',
+    'CW_SD', 'CW_V', 'CW_WIDTH', 'ENTRY', 'F_BASE', 'F_CONST', 'F_GRAV',
+    'F_ROWS', 'F_TOOL', 'F_TREE', 'first_nonfinite', 'flags',
+    'forward_kinematics', 'GRAVITY', 'jacobian', 'joint_trig', 'L_BODY',
+    'L_COM', 'L_INERTIA', 'L_LEAD', 'L_MASS', 'L_MULT', 'L_OFFSET', 'L_P',
+    'L_PARENT', 'L_R', 'L_STORE', 'L_TYPE', 'L_WIDTH', 'LINK_WRENCHES',
+    'mass_matrix_columns', 'mass_matrix_crba', 'MIMIC', 'momentum_terms',
+    'NONFINITE', 'OVERFLOW', 'pack', 'recursion', 'round_into', 'SINGULAR',
+    'SIZE', 'T_BRANCHED', 'T_NQ', 'T_TOOL', 'unit_columns', 'VELOCITY',
+    'W_ACC', 'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
+    'W_X', 'WRENCH_BASE', 'WRENCH_BITS', 'WRENCH_EE', 'WRENCH_NONE',
+    'WRENCH_SHIFT',
 ]
 
 # every entry point of entry.py (``run_<term>``, ``run_<term>_batch``):

@@ -24,38 +24,43 @@ they are given in; 6x6 matrices are stored row-major in 36 consecutive
 columns of an ``aw`` row.
 """
 from ._jit import njit
-from .kinematics import (axis_index, body_inertia, joint_trig, placement,
-                         revolute, stored_placement)
-from .layout import (A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, C_ONE, C_ZERO,
-                     F_BASE, F_CONST, F_GRAV, OVERFLOW, WRENCH_BASE,
-                     WRENCH_NONE)
-from .newton_euler import tip_wrench
-from .spatial import (add_block, block, cross, force_to_parent, frame_rot,
-                      mat6_vec, matmul, motion_to_child, skew, transpose, vec6)
+from .kinematics import (axis_index, body_inertia, branch_point,
+                         frame_rotation, has_mimic, joint_trig, parent,
+                         placement, revolute, stored_placement, tool_body)
+from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, C_ONE,
+                     C_ZERO, F_CONST, F_GRAV, MIMIC, OVERFLOW, WRENCH_NONE)
+from .newton_euler import link_wrench, tip_wrench
+from .spatial import (add_block, block, cross, force_to_parent, mat6_vec,
+                      matmul, motion_to_child, skew, transpose, vec6)
 from .status import first_nonfinite
 
 
 @njit(cache=True, inline='always')
-def aba_velocities(links, frames, qd, wrench, velocity_on, wrench_mode, ws,
-                   aw):
+def aba_velocities(links, frames, qd, wrench, fext, velocity_on,
+                   wrench_mode, link_wrenches, ws, aw):
     """
     ABA pass 1, base to tip: poses, velocities, bias accelerations.
 
     Stores R, p (``ws``), v_j, c_j = v_j x S_j qd_j, the link's spatial
     inertia as the starting articulated inertia IA_j and its bias force
-    pA_j = v_j x* (I_j v_j), plus the tip's wrench on the last link.
+    pA_j = v_j x* (I_j v_j), plus the tip's wrench on the tool's body and
+    the links' own wrenches (``fext``).
     """
     n = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
     v = (zero, zero, zero, zero, zero, zero)
-    Racc = frame_rot(frames, F_BASE)
+    tool = tool_body(frames) if wrench_mode != WRENCH_NONE else -2
     ident = (one, zero, zero, zero, one, zero, zero, zero, one)
     origin = (zero, zero, zero)
     for j in range(n):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's
+            if par < 0:
+                v = (zero, zero, zero, zero, zero, zero)
+            else:
+                v = vec6(aw, par, A_V)
         R, p = placement(links, frames, j, ws)
-        if wrench_mode == WRENCH_BASE:
-            Racc = matmul(Racc, R)
         body_inertia(links, j, ident, origin, aw, j, A_IA)
         c = (zero, zero, zero, zero, zero, zero)
         if velocity_on:
@@ -77,10 +82,15 @@ def aba_velocities(links, frames, qd, wrench, velocity_on, wrench_mode, ws,
                   t3[0], t3[1], t3[2])
         else:
             pa = (zero, zero, zero, zero, zero, zero)
-        if j == n - 1 and wrench_mode != WRENCH_NONE:
-            e = tip_wrench(frames, wrench, wrench_mode, Racc)
+        if j == tool:
+            e = tip_wrench(frames, wrench, wrench_mode,
+                           frame_rotation(links, frames, ws, j))
             pa = (pa[0] + e[0], pa[1] + e[1], pa[2] + e[2],
                   pa[3] + e[3], pa[4] + e[4], pa[5] + e[5])
+        if link_wrenches:
+            fe, ne = link_wrench(links, fext, j)
+            pa = (pa[0] + ne[0], pa[1] + ne[1], pa[2] + ne[2],
+                  pa[3] + fe[0], pa[4] + fe[1], pa[5] + fe[2])
         for k in range(6):
             aw[j, A_V + k] = v[k]
             aw[j, A_C + k] = c[k]
@@ -109,8 +119,9 @@ def aba_inertias(links, frames, tau, ws, aw):
             aw[j, A_U + r] = U[r]
         aw[j, A_D] = d
         aw[j, A_UU] = u
-        if j == 0:
-            break
+        par = parent(links, j)
+        if par < 0:
+            continue
         # Ia = IA - U U^T / d and pa = pA + Ia c + U u / d, in place
         for r in range(6):
             Ur = U[r] / d
@@ -121,7 +132,8 @@ def aba_inertias(links, frames, tau, ws, aw):
         ud = u / d
         for r in range(6):
             aw[j, A_PA + r] += aw[n, r] + U[r] * ud
-        # carry both into frame j-1 about O_{j-1}: X_F = [[R, [p] R], [0, R]]
+        # carry both into the parent's frame about its origin:
+        # X_F = [[R, [p] R], [0, R]]
         R, p = stored_placement(ws, j)
         Rt = transpose(R)
         P = skew(p)
@@ -139,30 +151,34 @@ def aba_inertias(links, frames, tau, ws, aw):
         TR = (B[0] + PM[0], B[1] + PM[1], B[2] + PM[2],
               B[3] + PM[3], B[4] + PM[4], B[5] + PM[5],
               B[6] + PM[6], B[7] + PM[7], B[8] + PM[8])
-        add_block(aw, j - 1, A_IA, 0, 0, TL)
-        add_block(aw, j - 1, A_IA, 0, 3, TR)
-        add_block(aw, j - 1, A_IA, 3, 0, transpose(TR))
-        add_block(aw, j - 1, A_IA, 3, 3, Mr)
+        add_block(aw, par, A_IA, 0, 0, TL)
+        add_block(aw, par, A_IA, 0, 3, TR)
+        add_block(aw, par, A_IA, 3, 0, transpose(TR))
+        add_block(aw, par, A_IA, 3, 3, Mr)
         f, m = force_to_parent(
             R, p, (aw[j, A_PA + 3], aw[j, A_PA + 4], aw[j, A_PA + 5]),
             (aw[j, A_PA], aw[j, A_PA + 1], aw[j, A_PA + 2]))
         for k in range(3):
-            aw[j - 1, A_PA + k] += m[k]
-            aw[j - 1, A_PA + 3 + k] += f[k]
+            aw[par, A_PA + k] += m[k]
+            aw[par, A_PA + 3 + k] += f[k]
     return -1
 
 
 @njit(cache=True, inline='always')
 def aba_accelerations(links, frames, gravity_on, ws, aw, qdd):
-    """ABA pass 3, base to tip: a_j = X a_{j-1} + c_j + S qdd_j."""
+    """ABA pass 3, base to tip: a_j = X a_lambda(j) + c_j + S qdd_j."""
     n = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     if gravity_on:      # gravity as an upward acceleration of the base
-        a = (zero, zero, zero, -frames[F_GRAV, 0], -frames[F_GRAV, 1],
-             -frames[F_GRAV, 2])
+        a0 = (zero, zero, zero, -frames[F_GRAV, 0], -frames[F_GRAV, 1],
+              -frames[F_GRAV, 2])
     else:
-        a = (zero, zero, zero, zero, zero, zero)
+        a0 = (zero, zero, zero, zero, zero, zero)
+    a = a0
     for j in range(n):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's
+            a = a0 if par < 0 else vec6(aw, par, A_A)
         R, p = stored_placement(ws, j)
         a = motion_to_child(R, p, a)
         a = (a[0] + aw[j, A_C], a[1] + aw[j, A_C + 1], a[2] + aw[j, A_C + 2],
@@ -177,11 +193,14 @@ def aba_accelerations(links, frames, gravity_on, ws, aw, qdd):
             a = (a[0], a[1], a[2] + x, a[3], a[4], a[5])
         else:
             a = (a[0], a[1], a[2], a[3], a[4], a[5] + x)
+        if branch_point(links, frames, j):
+            for k in range(6):
+                aw[j, A_A + k] = a[k]
 
 
 @njit(cache=True, inline='always')
-def articulated_body(links, frames, q, qd, tau, wrench, gravity_on,
-                     velocity_on, wrench_mode, ws, aw, qdd):
+def articulated_body(links, frames, q, qd, tau, wrench, fext, gravity_on,
+                     velocity_on, wrench_mode, link_wrenches, ws, aw, qdd):
     """
     Forward dynamics by the articulated-body algorithm: O(n).
 
@@ -190,15 +209,21 @@ def articulated_body(links, frames, q, qd, tau, wrench, gravity_on,
     inertias tip to base, accelerations base to tip).  Every spatial
     quantity of link j is in kernel frame j about O_j, where the joint's
     motion subspace S_j is a unit vector (z angular, or z linear).
-    ``aw`` is an (n + 1, A_WIDTH) workspace.
+    ``aw`` is an (n + 1, A_WIDTH) workspace.  On a tree each body starts
+    from its parent's velocity and acceleration and hands its articulated
+    inertia and bias force to its parent (Featherstone's parent array).
 
     Returns -1; or the index of the first joint (from the tip) with no
     inertia to move (D singular there); or OVERFLOW when finite inputs
-    overflow in qdd.
+    overflow in qdd; or MIMIC for a model with mimic joints, which this
+    algorithm does not take (Pinocchio's ``aba`` refuses them too): the
+    caller solves with D instead.
     """
+    if has_mimic(links, frames):
+        return MIMIC
     joint_trig(links, frames, q, ws)
-    aba_velocities(links, frames, qd, wrench, velocity_on, wrench_mode, ws,
-                   aw)
+    aba_velocities(links, frames, qd, wrench, fext, velocity_on, wrench_mode,
+                   link_wrenches, ws, aw)
     bad = aba_inertias(links, frames, tau, ws, aw)
     if bad >= 0:
         return bad

@@ -20,9 +20,11 @@ linear] and a force [moment; force], at the origin of frame 0 (the
 convention of Featherstone's book).
 """
 from ._jit import njit
-from .kinematics import body_inertia, joint_trig, link_geometry, revolute
-from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_OW,
-                     CW_RW, CW_S, CW_SD, CW_V, F_CONST)
+from .kinematics import (body_inertia, branch_point, branched, has_mimic,
+                         joint_rate, joint_trig, link_geometry, parent,
+                         put_pair, revolute, zero_matrix)
+from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_ICA,
+                     CW_OW, CW_RW, CW_S, CW_SD, CW_V, F_CONST)
 from .spatial import cross, load3, load9, mat6_vec, matmul, rot, skew, vec6
 from .status import matrix_status
 
@@ -34,15 +36,30 @@ def coriolis_forward(links, frames, qd, ws, cw):
 
     Stores each kernel frame's pose, each joint's motion subspace S_j
     ([z; o x z] revolute, [0; z] prismatic), each link's velocity
-    V_j = V_{j-1} + S_j qd_j and Sdot_j = V_j x S_j.
+    V_j = V_lambda(j) + S_j qd_j and Sdot_j = V_j x S_j.
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
-    Rw = (one, zero, zero, zero, one, zero, zero, zero, one)
+    mimic = has_mimic(links, frames)
+    ident = (one, zero, zero, zero, one, zero, zero, zero, one)
+    Rw = ident
     ow = (zero, zero, zero)
     V = (zero, zero, zero, zero, zero, zero)
-    for j in range(n):
+    for j in range(nb):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's
+            if par < 0:
+                Rw = ident
+                ow = (zero, zero, zero)
+                V = (zero, zero, zero, zero, zero, zero)
+            else:
+                Rw = load9(cw, par, CW_RW)
+                ow = load3(cw, par, CW_OW)
+                V = vec6(cw, par, CW_V)
+        if branch_point(links, frames, j):
+            for k in range(72):
+                cw[j, CW_ICA + k] = zero
         R, p = link_geometry(links, frames, j, ws)
         t = rot(Rw, p[0], p[1], p[2])
         ow = (ow[0] + t[0], ow[1] + t[1], ow[2] + t[2])
@@ -53,7 +70,7 @@ def coriolis_forward(links, frames, qd, ws, cw):
             S = (z[0], z[1], z[2], v[0], v[1], v[2])
         else:
             S = (zero, zero, zero, z[0], z[1], z[2])
-        s = qd[j]
+        s = joint_rate(links, qd, j, mimic)
         V = (V[0] + S[0] * s, V[1] + S[1] * s, V[2] + S[2] * s,
              V[3] + S[3] * s, V[4] + S[4] * s, V[5] + S[5] * s)
         # motion cross product V x S = [w x s_w; w x s_v + v x s_w]
@@ -79,9 +96,11 @@ def coriolis_backward(links, frames, cw):
     With I_k the spatial inertia of link k and
     B_k = (Y + Y^T + [I_k V_k]^) / 2, Y = (V_k x*) I_k, where
     [h]^ x = x x* h (Echeandia and Wensing's body Coriolis matrix in a
-    fixed frame), the composites IC_j = sum_{k >= j} I_k and
-    BC_j = sum_{k >= j} B_k give each joint's three vectors
-    F1 = IC S, F2 = BC^T S and G = IC Sdot + BC S.
+    fixed frame), the composites IC_j = sum_k I_k and BC_j = sum_k B_k
+    over j and its descendants k give each joint's three vectors
+    F1 = IC S, F2 = BC^T S and G = IC Sdot + BC S.  The running composite
+    is kept in the scratch row nb; at a branch it is added into the
+    parent's ``CW_ICA``, ``CW_BCA`` sums, which the parent adds in turn.
     """
     n = links.shape[0]
     half = frames[F_CONST, C_HALF]
@@ -92,6 +111,9 @@ def coriolis_backward(links, frames, cw):
     for k in range(72):
         cw[n, k] = zero
     for j in range(n - 1, -1, -1):
+        if branch_point(links, frames, j):      # the later children's
+            for k in range(72):
+                cw[n, k] += cw[j, CW_ICA + k]
         Rw = load9(cw, j, CW_RW)
         ow = load3(cw, j, CW_OW)
         body_inertia(links, j, Rw, ow, cw, j, CW_I)
@@ -141,6 +163,13 @@ def coriolis_backward(links, frames, cw):
             cw[j, CW_F1 + r] = f1
             cw[j, CW_F2 + r] = f2
             cw[j, CW_G + r] = g
+        par = parent(links, j)
+        if par != j - 1:        # a branch: into the parent's sums
+            if par >= 0:
+                for k in range(72):
+                    cw[par, CW_ICA + k] += cw[n, k]
+            for k in range(72):
+                cw[n, k] = zero
 
 
 @njit(cache=True, inline='always')
@@ -150,22 +179,26 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
 
     With body Jacobians in a fixed frame, C = sum_k J_k^T (I_k Jdot_k +
     B_k J_k) (see ``coriolis_backward``).  Column b of J_k is S_b for the
-    joints b up to k, so only the links beyond max(a, b) contribute to
-    C[a, b]:
+    joints b on the path from k to the base, so C[a, b] is zero unless one
+    of a, b is an ancestor of the other (or a == b), and only the links
+    beyond the farther one contribute:
 
-    - b <= a: C[a, b] = S_a^T (IC_a Sdot_b + BC_a S_b) = F1_a . Sdot_b
-      + F2_a . S_b
-    - b > a:  C[a, b] = S_a^T (IC_b Sdot_b + BC_b S_b) = S_a . G_b
+    - b ancestor of a, or b == a: C[a, b] = S_a^T (IC_a Sdot_b + BC_a S_b)
+      = F1_a . Sdot_b + F2_a . S_b
+    - a ancestor of b: C[a, b] = S_a^T (IC_b Sdot_b + BC_b S_b) = S_a . G_b
 
-    Two O(n) passes and 18 multiply-adds per entry, against the n
+    Two O(nb) passes and 18 multiply-adds per ancestor pair, against the n
     recursions of ``coriolis_matrix_columns``; the same C up to round-off.
-    ``cw`` is an (n + 1, CW_WIDTH) workspace.  Returns -1 or OVERFLOW.
+    ``cw`` is an (nb + 1, CW_WIDTH) workspace.  Returns -1 or OVERFLOW.
     """
-    n = links.shape[0]
+    nb = links.shape[0]
+    mimic = has_mimic(links, frames)
     joint_trig(links, frames, q, ws)
     coriolis_forward(links, frames, qd, ws, cw)
     coriolis_backward(links, frames, cw)
-    for a in range(n):
+    if mimic or branched(frames):
+        zero_matrix(frames, C)
+    for a in range(nb):
         f10 = cw[a, CW_F1]
         f11 = cw[a, CW_F1 + 1]
         f12 = cw[a, CW_F1 + 2]
@@ -178,21 +211,25 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
         f23 = cw[a, CW_F2 + 3]
         f24 = cw[a, CW_F2 + 4]
         f25 = cw[a, CW_F2 + 5]
-        for b in range(a + 1):
-            C[a, b] = ((f10 * cw[b, CW_SD] + f11 * cw[b, CW_SD + 1]
-                        + f12 * cw[b, CW_SD + 2] + f13 * cw[b, CW_SD + 3]
-                        + f14 * cw[b, CW_SD + 4] + f15 * cw[b, CW_SD + 5])
-                       + (f20 * cw[b, CW_S] + f21 * cw[b, CW_S + 1]
-                          + f22 * cw[b, CW_S + 2] + f23 * cw[b, CW_S + 3]
-                          + f24 * cw[b, CW_S + 4] + f25 * cw[b, CW_S + 5]))
-        s0 = cw[a, CW_S]
-        s1 = cw[a, CW_S + 1]
-        s2 = cw[a, CW_S + 2]
-        s3 = cw[a, CW_S + 3]
-        s4 = cw[a, CW_S + 4]
-        s5 = cw[a, CW_S + 5]
-        for b in range(a + 1, n):
-            C[a, b] = (s0 * cw[b, CW_G] + s1 * cw[b, CW_G + 1]
-                       + s2 * cw[b, CW_G + 2] + s3 * cw[b, CW_G + 3]
-                       + s4 * cw[b, CW_G + 4] + s5 * cw[b, CW_G + 5])
+        g0 = cw[a, CW_G]
+        g1 = cw[a, CW_G + 1]
+        g2 = cw[a, CW_G + 2]
+        g3 = cw[a, CW_G + 3]
+        g4 = cw[a, CW_G + 4]
+        g5 = cw[a, CW_G + 5]
+        b = a
+        while b >= 0:       # a itself, then its ancestors
+            x = ((f10 * cw[b, CW_SD] + f11 * cw[b, CW_SD + 1]
+                  + f12 * cw[b, CW_SD + 2] + f13 * cw[b, CW_SD + 3]
+                  + f14 * cw[b, CW_SD + 4] + f15 * cw[b, CW_SD + 5])
+                 + (f20 * cw[b, CW_S] + f21 * cw[b, CW_S + 1]
+                    + f22 * cw[b, CW_S + 2] + f23 * cw[b, CW_S + 3]
+                    + f24 * cw[b, CW_S + 4] + f25 * cw[b, CW_S + 5]))
+            put_pair(links, C, a, b, x, mimic)
+            if b != a:
+                x = (cw[b, CW_S] * g0 + cw[b, CW_S + 1] * g1
+                     + cw[b, CW_S + 2] * g2 + cw[b, CW_S + 3] * g3
+                     + cw[b, CW_S + 4] * g4 + cw[b, CW_S + 5] * g5)
+                put_pair(links, C, b, a, x, mimic)
+            b = parent(links, b)
     return matrix_status(C)

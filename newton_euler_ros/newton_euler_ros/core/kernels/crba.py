@@ -14,8 +14,11 @@
 
 """The joint-space mass matrix D(q) by the composite-rigid-body algorithm."""
 from ._jit import njit
-from .kinematics import joint_trig, placement, revolute, stored_placement
-from .layout import C_HALF, C_ZERO, F_CONST, L_COM, L_INERTIA, L_MASS
+from .kinematics import (branch_point, branched, has_mimic, joint_trig,
+                         parent, placement, put_pair, revolute,
+                         stored_placement, zero_matrix)
+from .layout import (C_HALF, C_ZERO, F_CONST, L_COM, L_INERTIA, L_MASS,
+                     W_ACC)
 from .spatial import force_to_parent, rot, sym_rotate
 from .status import matrix_status
 
@@ -58,18 +61,40 @@ def mass_matrix_crba(links, frames, q, ws, D):
     the same D as those up to round-off (the tests check 10 n eps in
     float64 and 1e-40 at 50 digits).
 
+    On a tree (Featherstone's CRBA with a parent array): composite i is
+    body i and its descendants, carried into its parent's frame and added
+    to the parent's composite (in registers on a chain, into the parent's
+    ``W_ACC`` sum at a branch point), and the unit-rate wrench goes up the
+    support path only, i's ancestors: D[j, i] = 0 for joints on different
+    branches, entries the pass never visits (zeroed first).  Mimic joints
+    add their entries to their leads' (D = G^T D_b G).
+
     Returns -1, or OVERFLOW when an entry is not finite (as ``mass_matrix_columns``).
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     half = frames[F_CONST, C_HALF]
+    mimic = has_mimic(links, frames)
     joint_trig(links, frames, q, ws)
-    for j in range(n):
+    for j in range(nb):
         R, p = placement(links, frames, j, ws)
+        if branch_point(links, frames, j):
+            for k in range(10):
+                ws[j, W_ACC + k] = zero
+    if mimic or branched(frames):
+        zero_matrix(frames, D)
     Mc = zero
     h = (zero, zero, zero)
     Io = (zero, zero, zero, zero, zero, zero)
-    for i in range(n - 1, -1, -1):
+    for i in range(nb - 1, -1, -1):
+        if branch_point(links, frames, i):      # the later children's
+            a = W_ACC
+            Mc = Mc + ws[i, a]
+            h = (h[0] + ws[i, a + 1], h[1] + ws[i, a + 2],
+                 h[2] + ws[i, a + 3])
+            Io = (Io[0] + ws[i, a + 4], Io[1] + ws[i, a + 5],
+                  Io[2] + ws[i, a + 6], Io[3] + ws[i, a + 7],
+                  Io[4] + ws[i, a + 8], Io[5] + ws[i, a + 9])
         # ---- add link i to the composite (frame i, about O_i) ----
         m = links[i, L_MASS]
         c0 = links[i, L_COM]
@@ -92,23 +117,28 @@ def mass_matrix_crba(links, frames, q, ws, D):
         if is_revolute:
             F = (-h[1], h[0], zero)
             N = (Io[5], Io[4], Io[2])
-            D[i, i] = N[2]
+            put_pair(links, D, i, i, N[2], mimic)
         else:
             F = (zero, zero, Mc)
             N = (h[1], -h[0], zero)
-            D[i, i] = F[2]
-        # ---- carry it to the base, joint by joint ----
-        for j in range(i - 1, -1, -1):
-            R, p = stored_placement(ws, j + 1)
+            put_pair(links, D, i, i, F[2], mimic)
+        # ---- carry it to the base, joint by joint up the support ----
+        k = i
+        j = parent(links, i)
+        while j >= 0:
+            R, p = stored_placement(ws, k)
             F, N = force_to_parent(R, p, F, N)
             if revolute(links, frames, j):
                 x = N[2]
             else:
                 x = F[2]
-            D[j, i] = x
-            D[i, j] = x
-        # ---- the composite in frame i-1, about O_{i-1} ----
-        if i > 0:
+            put_pair(links, D, j, i, x, mimic)
+            put_pair(links, D, i, j, x, mimic)
+            k = j
+            j = parent(links, j)
+        # ---- the composite in its parent's frame, about its origin ----
+        par = parent(links, i)
+        if par >= 0:
             R, p = stored_placement(ws, i)
             hr = rot(R, h[0], h[1], h[2])
             Ir = sym_rotate(R, Io)
@@ -124,4 +154,18 @@ def mass_matrix_crba(links, frames, q, ws, D):
                   Ir[4] - (gp[1] * p[2] + gp[2] * p[1]),
                   Ir[5] - (gp[0] * p[2] + gp[2] * p[0]))
             h = (hr[0] + Mc * p[0], hr[1] + Mc * p[1], hr[2] + Mc * p[2])
+            if par != i - 1:    # a branch: into the parent's sum
+                a = W_ACC
+                ws[par, a] += Mc
+                for k in range(3):
+                    ws[par, a + 1 + k] += h[k]
+                for k in range(6):
+                    ws[par, a + 4 + k] += Io[k]
+                Mc = zero
+                h = (zero, zero, zero)
+                Io = (zero, zero, zero, zero, zero, zero)
+        else:
+            Mc = zero
+            h = (zero, zero, zero)
+            Io = (zero, zero, zero, zero, zero, zero)
     return matrix_status(D)

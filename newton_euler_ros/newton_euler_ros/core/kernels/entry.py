@@ -46,13 +46,14 @@ from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
 from .generate import batch, entry
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, GRAVITY, NONFINITE,  # noqa
-                     OVERFLOW, SINGULAR, SIZE, VELOCITY, W_WIDTH,
-                     WRENCH_SHIFT)
+from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, F_TREE, GRAVITY,  # noqa
+                     LINK_WRENCHES, NONFINITE, OVERFLOW, SINGULAR, SIZE,
+                     T_NQ, VELOCITY, W_WIDTH, WRENCH_BITS, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
                            mass_matrix_columns, momentum_terms, recursion)
 from .regressor import drive_columns, regressor_columns
-from .status import first_nonfinite, matrix_status
+from .status import (first_nonfinite, first_nonfinite_entry,  # noqa: F401
+                     matrix_status)
 
 # A_WIDTH, CW_WIDTH, NONFINITE, SIZE and W_WIDTH are read by the generated
 # checks (generate.SHAPES), from this module's globals.
@@ -60,8 +61,14 @@ from .status import first_nonfinite, matrix_status
 
 @njit(cache=True)
 def _split(P):
-    n = P.shape[0] - F_ROWS
-    return P[:n], P[n:]
+    nb = P.shape[0] - F_ROWS
+    return P[:nb], P[nb:]
+
+
+@njit(cache=True, inline='always')
+def _coordinates(frames):
+    """Return the number of coordinates n (the generated checks' ``n``)."""
+    return int(frames[F_TREE, T_NQ])
 
 
 # ---------------------------------------------------------------------------
@@ -71,8 +78,23 @@ def _split(P):
 def inverse_dynamics_row(links, frames, q, qd, qdd, wrench, flags, ws, tau):
     """tau(q, qd, qdd, F_e); ``flags`` selects gravity, velocity, wrench."""
     joint_trig(links, frames, q, ws)
-    recursion(links, frames, qd, qd, qdd, wrench, (flags & GRAVITY) != 0,
-              (flags & VELOCITY) != 0, flags >> WRENCH_SHIFT, ws, tau)
+    recursion(links, frames, qd, qd, qdd, wrench, ws, (flags & GRAVITY) != 0,
+              (flags & VELOCITY) != 0, (flags >> WRENCH_SHIFT) & WRENCH_BITS,
+              False, ws, tau)
+    if first_nonfinite(tau) >= 0:
+        return OVERFLOW
+    return -1
+
+
+@njit(cache=True, inline='always')
+def inverse_dynamics_links_row(links, frames, q, qd, qdd, wrench, fext,
+                               flags, ws, tau):
+    """tau(q, qd, qdd, F_e) with wrenches at links (``fext``, link axes)."""
+    joint_trig(links, frames, q, ws)
+    recursion(links, frames, qd, qd, qdd, wrench, fext,
+              (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
+              (flags >> WRENCH_SHIFT) & WRENCH_BITS,
+              (flags & LINK_WRENCHES) != 0, ws, tau)
     if first_nonfinite(tau) >= 0:
         return OVERFLOW
     return -1
@@ -128,18 +150,32 @@ def momentum_terms_row(links, frames, q, qd, ws, cw, terms):
 def forward_dynamics_row(links, frames, q, qd, tau, wrench, flags, ws, aw,
                          qdd):
     """Compute qdd by the articulated-body algorithm (``articulated_body``)."""
-    bad = articulated_body(links, frames, q, qd, tau, wrench,
+    bad = articulated_body(links, frames, q, qd, tau, wrench, ws,
                            (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
-                           flags >> WRENCH_SHIFT, ws, aw, qdd)
+                           (flags >> WRENCH_SHIFT) & WRENCH_BITS, False, ws,
+                           aw, qdd)
+    if 0 <= bad < links.shape[0]:
+        return SINGULAR + bad
+    return bad
+
+
+@njit(cache=True)
+def forward_dynamics_links_row(links, frames, q, qd, tau, wrench, fext, flags,
+                               ws, aw, qdd):
+    """Compute qdd by the articulated-body algorithm, wrenches at links."""
+    bad = articulated_body(links, frames, q, qd, tau, wrench, fext,
+                           (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
+                           (flags >> WRENCH_SHIFT) & WRENCH_BITS,
+                           (flags & LINK_WRENCHES) != 0, ws, aw, qdd)
     if 0 <= bad < links.shape[0]:
         return SINGULAR + bad
     return bad
 
 
 @njit(cache=True, inline='always')
-def jacobian_row(links, frames, q, in_ee_axes, ws, Ts, J):
-    """J(q), 6 x n (see ``jacobian``)."""
-    jacobian(links, frames, q, in_ee_axes, ws, Ts, J)
+def jacobian_row(links, frames, q, body, target, local, ws, Ts, J):
+    """J(q), 6 x n, of a frame on a body (see ``jacobian``)."""
+    jacobian(links, frames, q, body, target, local, ws, Ts, J)
     return matrix_status(J)
 
 
@@ -152,10 +188,10 @@ def link_poses_row(links, frames, q, ws, Ts):
 
 @njit(cache=True, inline='always')
 def regressor_row(links, frames, q, qd, qdd, drives, eps, ws, line, acc, Y):
-    """Y(q, qd, qdd): n x 10n, and with ``drives`` the 4n drive columns."""
+    """Y(q, qd, qdd): n x 10nb, and with ``drives`` the 4n drive columns."""
     regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y)
     if drives:
-        drive_columns(frames, qd, qdd, eps, Y)
+        drive_columns(links, frames, qd, qdd, eps, Y)
     return -1
 
 
@@ -164,6 +200,7 @@ def regressor_row(links, frames, q, qd, qdd, drives, eps, ws, line, acc, Y):
 
 run_inverse_dynamics = entry(inverse_dynamics_row)
 run_inverse_dynamics_batch = batch(inverse_dynamics_row)
+run_inverse_dynamics_links = entry(inverse_dynamics_links_row)
 run_gravity_torques = entry(gravity_torques_row)
 run_gravity_torques_batch = batch(gravity_torques_row)
 run_mass_matrix_crba = entry(mass_matrix_crba_row)
@@ -175,6 +212,7 @@ run_coriolis_matrix_batch = batch(coriolis_matrix_composite_row,
 run_momentum_terms = entry(momentum_terms_row)
 run_forward_dynamics = entry(forward_dynamics_row)
 run_forward_dynamics_batch = batch(forward_dynamics_row)
+run_forward_dynamics_links = entry(forward_dynamics_links_row)
 run_jacobian = entry(jacobian_row)
 run_link_poses = entry(link_poses_row)
 run_regressor_batch = batch(regressor_row)

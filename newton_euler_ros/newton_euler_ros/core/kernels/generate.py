@@ -45,20 +45,22 @@ import inspect
 from ._jit import ENTRY, njit
 
 # The size of each argument by name, per axis: an expression in n (the
-# number of joints) that the axis must equal, or '>=' one it must reach.
+# number of coordinates: independent joints) or nb (the number of bodies:
+# moving joints, mimic ones included) that the axis must equal, or '>='
+# one it must reach.
 SHAPES = {
     'q': ('n',), 'qd': ('n',), 'qdd': ('n',), 'tau': ('n',),
-    'wrench': ('6',),
+    'wrench': ('6',), 'fext': ('nb', '6'), 'target': ('12',),
     'D': ('n', 'n'), 'C': ('n', 'n'), 'J': ('6', 'n'),
-    'ws': ('>=n', 'W_WIDTH'), 'aw': ('>=n + 1', 'A_WIDTH'),
-    'cw': ('>=n + 1', 'CW_WIDTH'), 'scratch': ('3', '>=n'),
-    'Ts': ('n + 2', '12'),
+    'ws': ('>=nb', 'W_WIDTH'), 'aw': ('>=nb + 1', 'A_WIDTH'),
+    'cw': ('>=nb + 1', 'CW_WIDTH'), 'scratch': ('3', '>=n'),
+    'Ts': ('nb + 2', '12'),
     'terms': ('3', 'n'),
-    'line': ('>=n', '6'), 'acc': ('>=10 * n', '6'),
-    'Y': ('n', '14 * n if drives else 10 * n'),
+    'line': ('>=nb', '6'), 'acc': ('>=10 * nb', '6'),
+    'Y': ('n', '10 * nb + 4 * n if drives else 10 * nb'),
 }
 # input a of the status codes (``calling.INPUTS``, ``calling.FD_INPUTS``)
-INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3}
+INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3, 'fext': 4}
 WORKSPACES = ('ws', 'aw', 'cw', 'scratch', 'Ts', 'line', 'acc')
 
 SOURCES = {}    # name -> the generated source of each entry point
@@ -112,7 +114,8 @@ def entry(row):
     lines = [f'def {name}(P, {", ".join(args)}):',
              f'    """{summary[0] if summary else name}"""',
              '    links, frames = _split(P)',
-             '    n = links.shape[0]']
+             '    nb = links.shape[0]',
+             '    n = _coordinates(frames)']
     for a in inputs:
         lines += _size_checks(a, f'SIZE + {INPUTS[a]}')
     for a in args:
@@ -120,8 +123,12 @@ def entry(row):
             lines += _size_checks(a, 'SIZE + 5')
         elif a == out:
             lines += _size_checks(a, 'SIZE + 4')
+    if 'body' in args:
+        lines += ['    if body < -1 or body >= nb:', '        return SIZE + 5']
     for a in inputs:
-        lines += [f'    i = first_nonfinite({a})', '    if i >= 0:',
+        check = ('first_nonfinite_entry' if len(SHAPES[a]) == 2
+                 else 'first_nonfinite')
+        lines += [f'    i = {check}({a})', '    if i >= 0:',
                   f'        return NONFINITE * {INPUTS[a]} + i']
     lines.append(f'    return {func.__name__}(links, frames, '
                  f'{", ".join(args)})')

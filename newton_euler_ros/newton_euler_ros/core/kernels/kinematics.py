@@ -13,23 +13,127 @@
 # limitations under the License.
 
 """
-Kinematics: joint placements, link poses, spatial inertias and the Jacobian.
+Kinematics: the tree, joint placements, poses, inertias and the Jacobian.
 
 Notation: every vector of link j is expressed in kernel frame j, whose z
 axis is the axis of joint j through its origin O_j (see
 ``model.compile_arrays``); R, p are the rotation and origin of kernel
-frame j in frame j-1, stored in ``ws`` (``W_R``, ``W_P``) by the pass that
-computes them (:func:`placement`) and read back by later passes
+frame j in the frame of its parent body lambda(j) (frame 0 for a joint on
+the base), stored in ``ws`` (``W_R``, ``W_P``) by the pass that computes
+them (:func:`placement`) and read back by later passes
 (:func:`stored_placement`).
+
+The tree.  Bodies are numbered parent first (``L_PARENT``: lambda(j) < j,
+-1 for the base), so a pass base to tip is a loop j = 0..nb-1 and a pass
+tip to base j = nb-1..0, as on a chain (lambda(j) = j - 1).  Where
+lambda(j) = j - 1 a pass keeps its running values in registers, as it
+would on a chain; only at a branch point (``L_STORE``: a child of j is
+not j + 1) does it store j's state in the workspace for the children
+that come later, and a backward pass adds what such a child carries into
+its parent's accumulator (``W_ACC``) instead of the registers.
+
+Mimic joints (``L_LEAD``, ``L_MULT``, ``L_OFFSET``).  A model with mimic
+joints has fewer coordinates n than bodies nb (``frames[F_TREE, T_NQ]``).
+Body j's joint then moves by q_j = mult q[lead] + offset, qd_j = mult
+qd[lead] (:func:`joint_rate`), and what it takes (a torque, a column of
+D, C, J or Y) goes to its lead coordinate times mult (:func:`put`,
+:func:`put_pair`): tau = G^T tau_b, D = G^T D_b G, J = J_b G with G the
+nb x n matrix of the multipliers.
 """
 import math
 
 from ._jit import njit
-from .layout import (C_ONE, C_ZERO, F_BASE, F_CONST, F_TOOL, L_BODY, L_COM,
-                     L_INERTIA, L_MASS, L_P, L_R, L_TYPE, W_CT, W_DD, W_P, W_R,
-                     W_ST)
+from .layout import (C_ONE, C_ZERO, F_BASE, F_CONST, F_TOOL, F_TREE, L_BODY,
+                     L_COM, L_INERTIA, L_LEAD, L_MASS, L_MULT, L_OFFSET, L_P,
+                     L_PARENT, L_R, L_STORE, L_TYPE, T_BRANCHED, T_NQ, T_TOOL,
+                     W_CT, W_DD, W_P, W_R, W_ST)
 from .spatial import (cross, frame_rot, load3, load9, matmul, rot, rot_t,
                       transpose)
+
+
+@njit(cache=True, inline='always')
+def parent(links, j):
+    """Return lambda(j), the parent body of body j (-1: the base)."""
+    return int(links[j, L_PARENT])
+
+
+@njit(cache=True, inline='always')
+def branch_point(links, frames, j):
+    """Tell whether body j has a child other than j + 1 (``L_STORE``)."""
+    return links[j, L_STORE] != frames[F_CONST, C_ZERO]
+
+
+@njit(cache=True, inline='always')
+def tool_body(frames):
+    """Return the body carrying the end-effector frame (-1: the base)."""
+    return int(frames[F_TREE, T_TOOL])
+
+
+@njit(cache=True, inline='always')
+def branched(frames):
+    """Tell whether some body's parent is not the body before it."""
+    return frames[F_TREE, T_BRANCHED] != frames[F_CONST, C_ZERO]
+
+
+@njit(cache=True, inline='always')
+def has_mimic(links, frames):
+    """Tell whether some joint follows another (fewer coordinates)."""
+    return links.shape[0] != int(frames[F_TREE, T_NQ])
+
+
+@njit(cache=True, inline='always')
+def joint_rate(links, x, j, mimic):
+    """Return body j's joint rate: x[j], or mult x[lead] (mimic)."""
+    if mimic:
+        return links[j, L_MULT] * x[int(links[j, L_LEAD])]
+    return x[j]
+
+
+@njit(cache=True, inline='always')
+def put(links, out, j, x, mimic):
+    """Put x, what body j's joint takes, into its coordinate of ``out``."""
+    if mimic:
+        out[int(links[j, L_LEAD])] += links[j, L_MULT] * x
+    else:
+        out[j] = x
+
+
+@njit(cache=True, inline='always')
+def put_pair(links, M, a, b, x, mimic):
+    """Entry (a, b) of a body matrix into M: M[a, b], or the leads' (G^T M G)."""
+    if mimic:
+        M[int(links[a, L_LEAD]), int(links[b, L_LEAD])] += (
+            links[a, L_MULT] * links[b, L_MULT]) * x
+    else:
+        M[a, b] = x
+
+
+@njit(cache=True, inline='always')
+def zero_matrix(frames, M):
+    """Set every entry of the 2-D array M to zero."""
+    zero = frames[F_CONST, C_ZERO]
+    for i in range(M.shape[0]):
+        for k in range(M.shape[1]):
+            M[i, k] = zero
+
+
+@njit(cache=True)
+def frame_rotation(links, frames, ws, j):
+    """
+    Rotation of kernel frame j in the base frame, from stored placements.
+
+    Walks up from j to the base (the placements of j and its ancestors
+    must be in ``ws``); frame 0's own rotation for j = -1.
+    """
+    Racc = frame_rot(frames, F_BASE)
+    if j < 0:
+        return Racc
+    R = load9(ws, j, W_R)
+    k = parent(links, j)
+    while k >= 0:
+        R = matmul(load9(ws, k, W_R), R)
+        k = parent(links, k)
+    return matmul(Racc, R)
 
 
 @njit(cache=True)
@@ -51,26 +155,33 @@ def joint_trig(links, frames, q, ws):
 
     A revolute joint's constant offset is part of its placement, so its
     angle is q itself: a large q is never rounded by adding an offset.
-    A prismatic joint needs no trigonometry per call.
+    A prismatic joint needs no trigonometry per call.  A mimic joint's
+    angle is mult q[lead] + offset (the URDF's ``<mimic>``).
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
-    for j in range(n):
+    mimic = has_mimic(links, frames)
+    for j in range(nb):
+        if mimic:
+            x = (links[j, L_MULT] * q[int(links[j, L_LEAD])]
+                 + links[j, L_OFFSET])
+        else:
+            x = q[j]
         if revolute(links, frames, j):
-            ws[j, W_CT] = math.cos(q[j])
-            ws[j, W_ST] = math.sin(q[j])
+            ws[j, W_CT] = math.cos(x)
+            ws[j, W_ST] = math.sin(x)
             ws[j, W_DD] = zero
         else:
             ws[j, W_CT] = one
             ws[j, W_ST] = zero
-            ws[j, W_DD] = q[j]
+            ws[j, W_DD] = x
 
 
 @njit(cache=True, inline='always')
 def link_geometry(links, frames, j, ws):
     """
-    R, p of kernel frame j in kernel frame j-1 at the trig values in ``ws``.
+    R, p of kernel frame j in its parent's at the trig values in ``ws``.
 
     R = R_place Rz(q) and p = p_place + R_place z * slide: a revolute joint
     mixes the first two columns of its placement, a prismatic one moves
@@ -99,7 +210,7 @@ def link_geometry(links, frames, j, ws):
 
 @njit(cache=True, inline='always')
 def placement(links, frames, j, ws):
-    """Return R, p of kernel frame j in j-1 (``link_geometry``), stored."""
+    """Return R, p of kernel frame j in its parent's, stored in ``ws``."""
     R, p = link_geometry(links, frames, j, ws)
     for k in range(9):
         ws[j, W_R + k] = R[k]
@@ -110,7 +221,7 @@ def placement(links, frames, j, ws):
 
 @njit(cache=True, inline='always')
 def stored_placement(ws, j):
-    """Return R, p of kernel frame j in j-1 as a pass stored them in ws."""
+    """Return R, p of kernel frame j in its parent's, as stored in ws."""
     return load9(ws, j, W_R), load3(ws, j, W_P)
 
 
@@ -154,13 +265,13 @@ def body_inertia(links, j, R, o, out, row, col):
 @njit(cache=True)
 def chain_poses(links, frames, q, ws, Ts, link_frames):
     """
-    Walk the chain and store the poses of its frames in ``Ts``.
+    Walk the tree and store the poses of its frames in ``Ts``.
 
-    Rows 1..n get kernel frames 1..n (or, with ``link_frames``, the link
-    frames of the model, B_j applied), row 0 frame 0, row n+1 the end
+    Rows 1..nb get kernel frames 1..nb (or, with ``link_frames``, the link
+    frames of the model, B_j applied), row 0 frame 0, row nb+1 the end
     effector; all in the base frame, each row R (9, row-major) then p (3).
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     joint_trig(links, frames, q, ws)
     Rw = frame_rot(frames, F_BASE)
     pw = (frames[F_BASE, 9], frames[F_BASE, 10], frames[F_BASE, 11])
@@ -168,54 +279,78 @@ def chain_poses(links, frames, q, ws, Ts, link_frames):
         Ts[0, k] = Rw[k]
     for k in range(3):
         Ts[0, 9 + k] = pw[k]
-    for j in range(n + 1):
-        if j < n:
-            R, p = link_geometry(links, frames, j, ws)
-        else:
-            R = frame_rot(frames, F_TOOL)
-            p = (frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11])
+    for j in range(nb):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's frame
+            Rw = load9(Ts, par + 1, 0)
+            pw = load3(Ts, par + 1, 9)
+        R, p = link_geometry(links, frames, j, ws)
         t = rot(Rw, p[0], p[1], p[2])
         pw = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
         Rw = matmul(Rw, R)
-        Ro = Rw
-        po = pw
-        if link_frames and j < n:
-            RB = load9(links, j, L_BODY)
+        for k in range(9):
+            Ts[j + 1, k] = Rw[k]
+        for k in range(3):
+            Ts[j + 1, 9 + k] = pw[k]
+    # the end effector, on its body's kernel frame
+    row = tool_body(frames) + 1
+    Rw = load9(Ts, row, 0)
+    pw = load3(Ts, row, 9)
+    t = rot(Rw, frames[F_TOOL, 9], frames[F_TOOL, 10], frames[F_TOOL, 11])
+    Ro = matmul(Rw, frame_rot(frames, F_TOOL))
+    for k in range(9):
+        Ts[nb + 1, k] = Ro[k]
+    for k in range(3):
+        Ts[nb + 1, 9 + k] = pw[k] + t[k]
+    if link_frames:
+        for j in range(nb):
+            Rw = load9(Ts, j + 1, 0)
+            pw = load3(Ts, j + 1, 9)
             t = rot(Rw, links[j, L_BODY + 9], links[j, L_BODY + 10],
                     links[j, L_BODY + 11])
-            po = (pw[0] + t[0], pw[1] + t[1], pw[2] + t[2])
-            Ro = matmul(Rw, RB)
-        for k in range(9):
-            Ts[j + 1, k] = Ro[k]
-        for k in range(3):
-            Ts[j + 1, 9 + k] = po[k]
+            Ro = matmul(Rw, load9(links, j, L_BODY))
+            for k in range(9):
+                Ts[j + 1, k] = Ro[k]
+            for k in range(3):
+                Ts[j + 1, 9 + k] = pw[k] + t[k]
 
 
 @njit(cache=True)
 def forward_kinematics(links, frames, q, ws, Ts):
     """
-    Poses of frame 0, the link frames 1..n and the end effector.
+    Poses of frame 0, the link frames 1..nb and the end effector.
 
-    ``Ts`` is (n + 2, 12), in the base frame: row 0 frame 0, rows 1..n the
-    model's link frames (where its inertial parameters are given), row
-    n+1 the end effector; each row R (9, row-major) then p (3).
+    ``Ts`` is (nb + 2, 12), in the base frame: row 0 frame 0, rows 1..nb
+    the model's link frames (where its inertial parameters are given), row
+    nb+1 the end effector; each row R (9, row-major) then p (3).
     """
     chain_poses(links, frames, q, ws, Ts, True)
 
 
 @njit(cache=True)
-def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
+def jacobian(links, frames, q, body, target, local, ws, Ts, J):
     """
-    Geometric Jacobian of the end-effector origin, rows [v; w].
+    Geometric Jacobian of a frame on body ``body``, rows [v; w], (6, n).
 
-    Base-frame axes, or end-effector axes when ``in_ee_axes``.  Cost O(n).
-    Joint j moves about z of kernel frame j, through its origin.
+    ``target`` is that frame's pose in kernel frame ``body`` (R, 9
+    row-major, then p); the end effector is ``frames[F_TOOL]`` on
+    ``tool_body``.  Base-frame axes, or the frame's own axes when
+    ``local``.  Only the joints on the path from the body to the base
+    move it: the other columns are zero (a mimic joint's column adds to
+    its lead's, times its multiplier).  Cost O(nb).
     """
-    n = links.shape[0]
     chain_poses(links, frames, q, ws, Ts, False)
-    pe = (Ts[n + 1, 9], Ts[n + 1, 10], Ts[n + 1, 11])
+    mimic = has_mimic(links, frames)
     zero = frames[F_CONST, C_ZERO]
-    for j in range(n):
+    zero_matrix(frames, J)
+    Rb = load9(Ts, body + 1, 0)
+    t = rot(Rb, target[9], target[10], target[11])
+    pe = (Ts[body + 1, 9] + t[0], Ts[body + 1, 10] + t[1],
+          Ts[body + 1, 11] + t[2])
+    Re = matmul(Rb, (target[0], target[1], target[2], target[3], target[4],
+                     target[5], target[6], target[7], target[8]))
+    j = body
+    while j >= 0:
         row = j + 1
         z = (Ts[row, 2], Ts[row, 5], Ts[row, 8])
         if revolute(links, frames, j):
@@ -226,10 +361,17 @@ def jacobian(links, frames, q, in_ee_axes, ws, Ts, J):
         else:
             lin = z
             ang = (zero, zero, zero)
-        if in_ee_axes:
-            Re = load9(Ts, n + 1, 0)
+        if local:
             lin = rot_t(Re, lin[0], lin[1], lin[2])
             ang = rot_t(Re, ang[0], ang[1], ang[2])
-        for k in range(3):
-            J[k, j] = lin[k]
-            J[3 + k, j] = ang[k]
+        if mimic:
+            col = int(links[j, L_LEAD])
+            s = links[j, L_MULT]
+            for k in range(3):
+                J[k, col] += s * lin[k]
+                J[3 + k, col] += s * ang[k]
+        else:
+            for k in range(3):
+                J[k, j] = lin[k]
+                J[3 + k, j] = ang[k]
+        j = parent(links, j)

@@ -26,26 +26,43 @@ Everything here is importable from :mod:`newton_euler_ros.core.kernels`
 (``from newton_euler_ros.core.kernels import L_MASS, F_GRAV``).
 """
 
-# ---- ``links``: per-link parameters, in kernel frames --------------------
-# (see ``model.compile_arrays``): kernel frame j is kernel frame j-1 moved
-# by the constant placement (R, p), then by Rz(q_j) (revolute) or Tz(q_j)
-# (prismatic).  The joint axis is z of kernel frame j and passes through
-# its origin.
+# ---- ``links``: one row per moving joint (body), in kernel frames -------
+# (see ``model.compile_arrays``).  The bodies form a tree numbered so that
+# a parent comes before its children: the parent of body j is body
+# lambda(j) < j, or the base (-1); a chain has lambda(j) = j - 1.  Kernel
+# frame j is kernel frame lambda(j) moved by the constant placement
+# (R, p), then by Rz(q_j) (revolute) or Tz(q_j) (prismatic).  The joint
+# axis is z of kernel frame j and passes through its origin.  A mimic
+# joint has no coordinate of its own: its angle is mult * q[lead] + offset
+# (an independent joint: lead its own coordinate, mult 1, offset 0).
 L_TYPE = 0       # 0.0 revolute, 1.0 prismatic
-L_R = 1          # 9, row-major: placement rotation in kernel frame j-1
-L_P = 10         # 3: placement origin in kernel frame j-1
+L_R = 1          # 9, row-major: placement rotation in kernel frame lambda(j)
+L_P = 10         # 3: placement origin in kernel frame lambda(j)
 L_MASS = 13
 L_COM = 14       # 3 columns, kernel frame j
 L_INERTIA = 17   # 9 columns, row-major, about the com in kernel-frame axes
 L_BODY = 26      # 12: R (9) then p (3) of link frame j in kernel frame j
-L_WIDTH = 38
+L_PARENT = 38    # lambda(j), the parent body (-1.0: the base)
+L_LEAD = 39      # the coordinate (index into q) that moves joint j
+L_MULT = 40      # its multiplier (1.0 for an independent joint)
+L_OFFSET = 41    # its offset (0.0 for an independent joint)
+L_STORE = 42     # 1.0 when a child of j is not j + 1: the passes keep
+#                  j's state in the workspace for it (a branch point)
+L_WIDTH = 43
 
 # ---- ``frames``: rows of fixed frames, shape (F_ROWS, 12) ----------------
 F_BASE = 0       # R (9, row-major) then p (3): DH frame 0 in the base frame
 F_TOOL = 1       # end-effector frame in the last link frame
 F_GRAV = 2       # first 3 entries: gravity in frame-0 axes
 F_CONST = 3      # the constants below, in the arrays' own number type
-F_ROWS = 4
+F_TREE = 4       # the tree's shape, the T_* columns below
+F_ROWS = 5
+
+# Columns of the tree row ``frames[F_TREE]`` (integers, in the arrays'
+# number type).
+T_NQ = 0         # the number of coordinates n (independent joints)
+T_TOOL = 1       # the body carrying the end-effector frame (-1: the base)
+T_BRANCHED = 2   # 1 when some body's parent is not the body before it
 
 # Columns of the constants row ``frames[F_CONST]``.  A float literal in
 # numba code is a float64, and float32 op float64 is float64: the kernels
@@ -64,7 +81,13 @@ W_N = 15         # 3: net moment about the com, Newton-Euler
 W_CT = 18        # cos(q_j) (1 for a prismatic joint)
 W_ST = 19        # sin(q_j) (0 for a prismatic joint)
 W_DD = 20        # q_j for a prismatic joint (0 for a revolute one)
-W_WIDTH = 21
+W_X = 21         # 24: a branch point's state for its children (each pass
+#                  its own: velocities, accelerations, poses)
+W_ACC = 45       # 12: what a branch point's children carried back to it
+#                  (wrenches, composite bodies), summed
+W_R0 = 57        # 9: rotation of kernel frame j in the base frame (link
+#                  wrenches in base axes)
+W_WIDTH = 66
 
 # ---- ``aw``: the articulated-body workspace (n + 1 rows; row n scratch) --
 # Spatial vectors are [angular; linear] (motion) or [moment; force]
@@ -76,7 +99,8 @@ A_C = 48         # 6: velocity-product acceleration v_j x (S_j qd_j)
 A_U = 54         # 6: U = IA S (the column of IA on the joint axis)
 A_D = 60         # d = S^T IA S, the articulated inertia on the axis
 A_UU = 61        # u = tau - S^T pA
-A_WIDTH = 62
+A_A = 62         # 6: spatial acceleration of a branch point
+A_WIDTH = 68
 
 # ---- ``cw``: the composite Coriolis workspace (n + 1 rows) ---------------
 # Row n is scratch: the composite inertia IC (36), the composite Coriolis
@@ -90,7 +114,10 @@ CW_RW = 30       # 9: rotation of kernel frame j in frame 0
 CW_OW = 39       # 3: origin of kernel frame j in frame 0
 CW_V = 42        # 6: spatial velocity of link j
 CW_I = 48        # 36: spatial inertia of link j, frame 0 about its origin
-CW_WIDTH = 84
+CW_ICA = 84      # 36: composite inertia the children of a branch point
+#                  carried back to it (summed)
+CW_BCA = 120     # 36: the same of their composite Coriolis matrices
+CW_WIDTH = 156
 CS_IC = 0        # scratch row: composite inertia (36)
 CS_BC = 36       # composite Coriolis matrix (36)
 CS_H = 72        # I_j V_j (6)
@@ -104,7 +131,9 @@ WRENCH_EE = 2
 # Bits of an entry point's ``flags``.
 GRAVITY = 1
 VELOCITY = 2
-WRENCH_SHIFT = 2     # the wrench mode, shifted
+WRENCH_SHIFT = 2     # the wrench mode, shifted (two bits)
+WRENCH_BITS = 3      # mask of the mode once shifted
+LINK_WRENCHES = 16   # wrenches at links (``fext``) are applied
 
 # Status codes returned by the kernels (-1 is success):
 #   1000 * a + i   input a (0 q, 1 qd, 2 qdd or tau, 3 wrench) is not
@@ -114,12 +143,16 @@ SIZE = 8000      # + a: input a has the wrong size (4: an output, 5: the
 #                  workspace)
 OVERFLOW = 9000  # finite inputs overflowed in the result
 SINGULAR = 10000  # + j: no inertia moves with joint j (D is singular)
+MIMIC = 20000    # the articulated-body algorithm met a mimic joint: the
+#                  caller solves D qdd = tau - bias instead
 
 
-def flags(gravity=True, velocity=True, wrench_mode=WRENCH_NONE):
+def flags(gravity=True, velocity=True, wrench_mode=WRENCH_NONE,
+          link_wrenches=False):
     """Return the ``flags`` integer of the entry points."""
     return ((GRAVITY if gravity else 0) | (VELOCITY if velocity else 0)
-            | (wrench_mode << WRENCH_SHIFT))
+            | (wrench_mode << WRENCH_SHIFT)
+            | (LINK_WRENCHES if link_wrenches else 0))
 
 
 def pack(links, frames):

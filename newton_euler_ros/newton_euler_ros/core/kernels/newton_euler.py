@@ -54,74 +54,105 @@ keep only the ``zdot qd`` half and miss the half that comes from
 differentiating ``w x r`` while r grows at the rate ``z qd``.
 """
 from ._jit import njit
-from .kinematics import (joint_trig, link_inertia, placement, revolute,
-                         stored_placement)
-from .layout import (C_HALF, C_ONE, C_ZERO, CW_V, F_BASE, F_CONST, F_GRAV,
-                     F_TOOL, L_COM, L_MASS, W_F, W_N, WRENCH_BASE,
-                     WRENCH_NONE)
-from .spatial import cross, force_to_parent, frame_rot, matmul, rot, rot_t
+from .kinematics import (branch_point, frame_rotation, has_mimic, joint_rate,
+                         joint_trig, link_inertia, parent, placement, put,
+                         revolute, stored_placement, tool_body, zero_matrix)
+from .layout import (C_HALF, C_ONE, C_ZERO, CW_V, F_CONST, F_GRAV, F_TOOL,
+                     L_BODY, L_COM, L_MASS, W_ACC, W_F, W_N, W_X,
+                     WRENCH_BASE, WRENCH_NONE)
+from .spatial import (cross, force_to_parent, frame_rot, load3, load9,
+                      matmul, rot, rot_t)
 from .status import matrix_status
 
 
 @njit(cache=True, inline='always')
-def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
-              wrench_mode, ws, tau):
+def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
+              velocity_on, wrench_mode, link_wrenches, ws, tau):
     """
     Newton-Euler recursion: tau = D qdd + C(q, qd) v [+ g] [+ J^T F_e].
 
     ``joint_trig(links, frames, q, ws)`` must have been called for the same q.
-    A forward step per joint, base to tip, then a backward step per joint,
+    A forward step per body, base to tip, then a backward step per body,
     tip to base, as in the seed text (Pinocchio's RneaForwardStep and
-    RneaBackwardStep).  They are written inline, in one function: numba
-    passes arrays and tuples between functions at a cost (measured: 35%
-    more per call with the steps as functions, inlined or not).
-    Cost: about 250 flops per joint, O(n).  Every vector of link j is in
-    kernel frame j, whose z axis is joint j's axis through its origin.
+    RneaBackwardStep), on the tree: body j starts from its parent's
+    velocities and accelerations, and its parent takes the wrench it
+    transmits.  On a chain the running values stay in registers; a
+    branch point stores its state for its later children (``W_X``) and
+    sums what they carry back (``W_ACC``).  The steps are written inline,
+    in one function: numba passes arrays and tuples between functions at a
+    cost (measured: 35% more per call with the steps as functions, inlined
+    or not).  Cost: about 250 flops per body, O(nb).  Every vector of link
+    j is in kernel frame j, whose z axis is joint j's axis through its
+    origin.
 
     Parameters
     ----------
-    links : (n, L_WIDTH) array
-        Per-joint placement, mass, centre-of-mass and inertia parameters
-        (the ``L_*`` columns).
+    links : (nb, L_WIDTH) array
+        Per-body placement, parent, mass, centre-of-mass and inertia
+        parameters (the ``L_*`` columns).
     frames : (F_ROWS, 12) array
-        Base frame, tool frame, gravity and constants (the ``F_*`` rows).
+        Base frame, tool frame, gravity, constants and the tree's shape
+        (the ``F_*`` rows).
     qd, v, qdd : (n,) arrays
-        Joint velocity, reference velocity, acceleration.
+        Joint velocity, reference velocity, acceleration (coordinates: a
+        mimic joint moves with its lead).
     wrench : (6,) array
         [f; n] exerted by the end effector on its environment, moment about
         the end-effector origin; base-frame axes when
         ``wrench_mode == WRENCH_BASE``, end-effector axes when
         ``WRENCH_EE``; ignored when ``WRENCH_NONE``.
+    fext : (nb, 6) array
+        With ``link_wrenches``: row j is [f; n] exerted by link j on its
+        environment, in link j's axes, the moment about its origin
+        (several links at once); ignored otherwise.
     gravity_on, velocity_on : bool
         Skip the gravity or velocity-product terms altogether when False.
     wrench_mode : int
         ``WRENCH_NONE``, ``WRENCH_BASE`` or ``WRENCH_EE``.
-    ws : (n, W_WIDTH) array
+    link_wrenches : bool
+        Apply ``fext``.
+    ws : (nb, W_WIDTH) array
         Workspace: reads the trig columns ``joint_trig`` filled, overwrites
         the other ``W_*`` columns.
     tau : (n,) array
         Output.
 
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     half = frames[F_CONST, C_HALF]
+    mimic = has_mimic(links, frames)
     # Gravity enters as an upward acceleration of the base: a_0 = -g.
     if gravity_on:
-        ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+        a0 = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
     else:
-        ae = (zero, zero, zero)
+        a0 = (zero, zero, zero)
+    ae = a0
     w = (zero, zero, zero)
     r = (zero, zero, zero)
     al = (zero, zero, zero)
-    Racc = frame_rot(frames, F_BASE)
 
     # ---- forward steps, base to tip: the seed's eqs. (19)-(21) ----
-    # from link j-1's w, r, al, ae (frame j-1 axes) to link j's (frame j
-    # axes); link j's net force m a_c and moment about its com into ws
-    for j in range(n):
+    # from the parent's w, r, al, ae (its frame's axes) to link j's (frame
+    # j axes); link j's net force m a_c and moment about its com into ws
+    for j in range(nb):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's state
+            if par < 0:
+                w = (zero, zero, zero)
+                r = (zero, zero, zero)
+                al = (zero, zero, zero)
+                ae = a0
+            else:
+                w = load3(ws, par, W_X)
+                r = load3(ws, par, W_X + 3)
+                al = load3(ws, par, W_X + 6)
+                ae = load3(ws, par, W_X + 9)
         R, p = placement(links, frames, j, ws)
-        # acceleration of the new origin O_j, still in frame j-1 axes
+        qdj = joint_rate(links, qd, j, mimic)
+        vj = joint_rate(links, v, j, mimic)
+        qddj = joint_rate(links, qdd, j, mimic)
+        # acceleration of the new origin O_j, still in the parent's axes
         t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
         ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
         if velocity_on:
@@ -137,19 +168,27 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
             r = rot_t(R, r[0], r[1], r[2])
             if is_revolute:
                 # alpha_j = R^T alpha_{j-1} + z qdd + (r_{j-1} x z) qd_j
-                al = (al[0] + r[1] * qd[j], al[1] - r[0] * qd[j],
-                      al[2] + qdd[j])
-                w = (w[0], w[1], w[2] + qd[j])
-                r = (r[0], r[1], r[2] + v[j])
+                al = (al[0] + r[1] * qdj, al[1] - r[0] * qdj,
+                      al[2] + qddj)
+                w = (w[0], w[1], w[2] + qdj)
+                r = (r[0], r[1], r[2] + vj)
             else:
                 # the sliding joint: z qdd + Coriolis 2 w x z qd (v == qd)
-                ae = (ae[0] + r[1] * qd[j] + w[1] * v[j],
-                      ae[1] - r[0] * qd[j] - w[0] * v[j],
-                      ae[2] + qdd[j])
+                ae = (ae[0] + r[1] * qdj + w[1] * vj,
+                      ae[1] - r[0] * qdj - w[0] * vj,
+                      ae[2] + qddj)
         elif is_revolute:
-            al = (al[0], al[1], al[2] + qdd[j])
+            al = (al[0], al[1], al[2] + qddj)
         else:
-            ae = (ae[0], ae[1], ae[2] + qdd[j])
+            ae = (ae[0], ae[1], ae[2] + qddj)
+        if branch_point(links, frames, j):
+            for k in range(3):
+                ws[j, W_X + k] = w[k]
+                ws[j, W_X + 3 + k] = r[k]
+                ws[j, W_X + 6 + k] = al[k]
+                ws[j, W_X + 9 + k] = ae[k]
+            for k in range(6):
+                ws[j, W_ACC + k] = zero
         # acceleration of the centre of mass
         c0 = links[j, L_COM]
         c1 = links[j, L_COM + 1]
@@ -181,21 +220,33 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         ws[j, W_N] = Nn[0]
         ws[j, W_N + 1] = Nn[1]
         ws[j, W_N + 2] = Nn[2]
-        if wrench_mode == WRENCH_BASE:
-            Racc = matmul(Racc, R)
-
-    # ---- the wrench the tip exerts, as "f_{n+1}, tau_{n+1}" in frame n ----
-    f = (zero, zero, zero)
-    nm = (zero, zero, zero)
-    if wrench_mode != WRENCH_NONE:
-        e = tip_wrench(frames, wrench, wrench_mode, Racc)
-        nm = (e[0], e[1], e[2])
-        f = (e[3], e[4], e[5])
 
     # ---- backward steps, tip to base: the force and moment balance ----
     # f, nm hold the force and the moment (about O_j) that link j exerts on
-    # its child, in frame j axes.
-    for j in range(n - 1, -1, -1):
+    # its children and its environment, in frame j axes; the wrench the
+    # end effector exerts (the seed's "f_{n+1}, tau_{n+1}") enters at the
+    # tool's body
+    if mimic:
+        for i in range(tau.shape[0]):
+            tau[i] = zero
+    tool = tool_body(frames) if wrench_mode != WRENCH_NONE else -2
+    f = (zero, zero, zero)
+    nm = (zero, zero, zero)
+    for j in range(nb - 1, -1, -1):
+        if branch_point(links, frames, j):
+            f = (f[0] + ws[j, W_ACC], f[1] + ws[j, W_ACC + 1],
+                 f[2] + ws[j, W_ACC + 2])
+            nm = (nm[0] + ws[j, W_ACC + 3], nm[1] + ws[j, W_ACC + 4],
+                  nm[2] + ws[j, W_ACC + 5])
+        if j == tool:
+            e = tip_wrench(frames, wrench, wrench_mode,
+                           frame_rotation(links, frames, ws, j))
+            nm = (nm[0] + e[0], nm[1] + e[1], nm[2] + e[2])
+            f = (f[0] + e[3], f[1] + e[4], f[2] + e[5])
+        if link_wrenches:
+            fe, ne = link_wrench(links, fext, j)
+            f = (f[0] + fe[0], f[1] + fe[1], f[2] + fe[2])
+            nm = (nm[0] + ne[0], nm[1] + ne[1], nm[2] + ne[2])
         F0 = ws[j, W_F]
         F1 = ws[j, W_F + 1]
         F2 = ws[j, W_F + 2]
@@ -207,20 +258,48 @@ def recursion(links, frames, qd, v, qdd, wrench, gravity_on, velocity_on,
         # the joint takes the moment about (revolute) or the force along
         # (prismatic) its axis z
         if revolute(links, frames, j):
-            tau[j] = nm[2]
+            put(links, tau, j, nm[2], mimic)
         else:
-            tau[j] = f[2]
-        if j > 0:
+            put(links, tau, j, f[2], mimic)
+        par = parent(links, j)
+        if par >= 0:
             R, p = stored_placement(ws, j)
             f, nm = force_to_parent(R, p, f, nm)
+            if par != j - 1:    # a branch: into the parent's sum
+                for k in range(3):
+                    ws[par, W_ACC + k] += f[k]
+                    ws[par, W_ACC + 3 + k] += nm[k]
+                f = (zero, zero, zero)
+                nm = (zero, zero, zero)
+        else:
+            f = (zero, zero, zero)
+            nm = (zero, zero, zero)
+
+
+@njit(cache=True, inline='always')
+def link_wrench(links, fext, j):
+    """
+    Return fext[j] (link j's axes, about its origin) in kernel frame j.
+
+    As (f, n), the moment about O_j: with (R_B, p_B) the link frame in
+    kernel frame j, f' = R_B f and n' = R_B n + p_B x f'.
+    """
+    RB = load9(links, j, L_BODY)
+    f = rot(RB, fext[j, 0], fext[j, 1], fext[j, 2])
+    n = rot(RB, fext[j, 3], fext[j, 4], fext[j, 5])
+    t = cross(links[j, L_BODY + 9], links[j, L_BODY + 10],
+              links[j, L_BODY + 11], f[0], f[1], f[2])
+    return f, (n[0] + t[0], n[1] + t[1], n[2] + t[2])
 
 
 @njit(cache=True)
 def tip_wrench(frames, wrench, wrench_mode, Racc):
     """
-    Return the wrench the tip exerts, at O_n in frame-n axes: [n; f].
+    Return the wrench the tip exerts, at its body's kernel frame: [n; f].
 
-    ``Racc`` is the rotation of frame n in the base frame (used for
+    About the origin of the kernel frame of the tool's body, in its axes.
+
+    ``Racc`` is the rotation of that frame in the base frame (used for
     ``WRENCH_BASE``).  As the recursion's "f_{n+1}, tau_{n+1}".
     """
     Rt = frame_rot(frames, F_TOOL)
@@ -246,8 +325,8 @@ def gravity(links, frames, q, ws, tau):
     # backward pass writes the torques into it
     for j in range(tau.shape[0]):
         tau[j] = frames[F_CONST, C_ZERO]
-    recursion(links, frames, unused, unused, tau, unused, True, False,
-              WRENCH_NONE, ws, tau)
+    recursion(links, frames, unused, unused, tau, unused, ws, True, False,
+              WRENCH_NONE, False, ws, tau)
 
 
 @njit(cache=True)
@@ -257,9 +336,9 @@ def unit_columns(links, frames, qd, coriolis, ws, scratch, M):
 
     D e_k = Y(q, 0, 0, e_k) and C e_k = Y(q, qd, e_k, 0), where Y is the
     two-stream recursion; ``joint_trig`` must have been called for q.
-    ``scratch`` is a (3, n) array.  Cost: n recursions, O(n^2).
+    ``scratch`` is a (3, n) array.  Cost: n recursions, O(n nb).
     """
-    n = links.shape[0]
+    n = M.shape[0]
     zero = scratch[0]
     unit = scratch[1]
     col = scratch[2]
@@ -269,11 +348,11 @@ def unit_columns(links, frames, qd, coriolis, ws, scratch, M):
     for k in range(n):
         unit[k] = frames[F_CONST, C_ONE]
         if coriolis:
-            recursion(links, frames, qd, unit, zero, zero, False, True,
-                      WRENCH_NONE, ws, col)
+            recursion(links, frames, qd, unit, zero, zero, ws, False, True,
+                      WRENCH_NONE, False, ws, col)
         else:
-            recursion(links, frames, zero, zero, unit, zero, False, False,
-                      WRENCH_NONE, ws, col)
+            recursion(links, frames, zero, zero, unit, zero, ws, False,
+                      False, WRENCH_NONE, False, ws, col)
         unit[k] = frames[F_CONST, C_ZERO]
         for i in range(n):
             M[i, k] = col[i]
@@ -282,7 +361,7 @@ def unit_columns(links, frames, qd, coriolis, ws, scratch, M):
 @njit(cache=True)
 def mass_matrix_columns(links, frames, q, ws, scratch, D):
     """D(q) column by column: D e_k = recursion(qd = 0, qdd = e_k)."""
-    n = links.shape[0]
+    n = D.shape[0]
     half = frames[F_CONST, C_HALF]
     joint_trig(links, frames, q, ws)
     unit_columns(links, frames, q, False, ws, scratch, D)
@@ -309,7 +388,8 @@ def momentum_terms(links, frames, q, qd, ws, cw, out):
     Compute D(q) qd, C(q, qd)^T qd and g(q) in one O(n) recursion.
 
     What the momentum observer needs at each sample, into the rows 0, 1,
-    2 of ``out`` (3, n), without forming D or C.  With the body Jacobians
+    2 of ``out`` (3, n), without forming D or C; on a tree the composites
+    are summed at branch points as in ``recursion``.  With the body Jacobians
     J_k (column b the joint motion S_b for b <= k) and each link's spatial
     momentum h_k = I_k J_k qd:
 
@@ -339,38 +419,63 @@ def momentum_terms(links, frames, q, qd, ws, cw, out):
     round-off, at about a third of their cost.  Returns -1, or OVERFLOW
     when a result is not finite.
     """
-    n = links.shape[0]
+    nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
+    mimic = has_mimic(links, frames)
     joint_trig(links, frames, q, ws)
     w = (zero, zero, zero)
     v = (zero, zero, zero)
-    a = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    a0 = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    a = a0
     # ---- forward: w, v of each link, and gravity's force on it ----
-    for j in range(n):
+    for j in range(nb):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's state
+            if par < 0:
+                w = (zero, zero, zero)
+                v = (zero, zero, zero)
+                a = a0
+            else:
+                w = load3(cw, par, CW_V)
+                v = load3(cw, par, CW_V + 3)
+                a = load3(ws, par, W_X)
         R, p = placement(links, frames, j, ws)
         t = cross(w[0], w[1], w[2], p[0], p[1], p[2])
         v = rot_t(R, v[0] + t[0], v[1] + t[1], v[2] + t[2])
         w = rot_t(R, w[0], w[1], w[2])
         a = rot_t(R, a[0], a[1], a[2])
+        s = joint_rate(links, qd, j, mimic)
         if revolute(links, frames, j):
-            w = (w[0], w[1], w[2] + qd[j])
+            w = (w[0], w[1], w[2] + s)
         else:
-            v = (v[0], v[1], v[2] + qd[j])
+            v = (v[0], v[1], v[2] + s)
         m = links[j, L_MASS]
         for k in range(3):
             cw[j, CW_V + k] = w[k]
             cw[j, CW_V + 3 + k] = v[k]
             ws[j, W_F + k] = m * a[k]
+        if branch_point(links, frames, j):
+            for k in range(3):
+                ws[j, W_X + k] = a[k]
+            for k in range(12):
+                ws[j, W_ACC + k] = zero
     # ---- backward: composite momentum and gravity wrench ----
+    if mimic:
+        zero_matrix(frames, out)
     L = (zero, zero, zero)
     K = (zero, zero, zero)
     f = (zero, zero, zero)
     nm = (zero, zero, zero)
-    for j in range(n - 1, -1, -1):
-        if j < n - 1:
-            R, p = stored_placement(ws, j + 1)
-            L, K = force_to_parent(R, p, L, K)
-            f, nm = force_to_parent(R, p, f, nm)
+    for j in range(nb - 1, -1, -1):
+        if branch_point(links, frames, j):
+            L = (L[0] + ws[j, W_ACC], L[1] + ws[j, W_ACC + 1],
+                 L[2] + ws[j, W_ACC + 2])
+            K = (K[0] + ws[j, W_ACC + 3], K[1] + ws[j, W_ACC + 4],
+                 K[2] + ws[j, W_ACC + 5])
+            f = (f[0] + ws[j, W_ACC + 6], f[1] + ws[j, W_ACC + 7],
+                 f[2] + ws[j, W_ACC + 8])
+            nm = (nm[0] + ws[j, W_ACC + 9], nm[1] + ws[j, W_ACC + 10],
+                  nm[2] + ws[j, W_ACC + 11])
         w = (cw[j, CW_V], cw[j, CW_V + 1], cw[j, CW_V + 2])
         v = (cw[j, CW_V + 3], cw[j, CW_V + 4], cw[j, CW_V + 5])
         m = links[j, L_MASS]
@@ -390,12 +495,32 @@ def momentum_terms(links, frames, q, qd, ws, cw, out):
         f = (f[0] + F0, f[1] + F1, f[2] + F2)
         nm = (nm[0] + t[0], nm[1] + t[1], nm[2] + t[2])
         if revolute(links, frames, j):
-            out[0, j] = K[2]
-            out[1, j] = ((w[1] * K[0] - w[0] * K[1])
-                         + (v[1] * L[0] - v[0] * L[1]))
-            out[2, j] = nm[2]
+            put(links, out[0], j, K[2], mimic)
+            put(links, out[1], j, (w[1] * K[0] - w[0] * K[1])
+                + (v[1] * L[0] - v[0] * L[1]), mimic)
+            put(links, out[2], j, nm[2], mimic)
         else:
-            out[0, j] = L[2]
-            out[1, j] = w[1] * L[0] - w[0] * L[1]
-            out[2, j] = f[2]
+            put(links, out[0], j, L[2], mimic)
+            put(links, out[1], j, w[1] * L[0] - w[0] * L[1], mimic)
+            put(links, out[2], j, f[2], mimic)
+        par = parent(links, j)
+        if par >= 0:
+            R, p = stored_placement(ws, j)
+            L, K = force_to_parent(R, p, L, K)
+            f, nm = force_to_parent(R, p, f, nm)
+            if par != j - 1:    # a branch: into the parent's sums
+                for k in range(3):
+                    ws[par, W_ACC + k] += L[k]
+                    ws[par, W_ACC + 3 + k] += K[k]
+                    ws[par, W_ACC + 6 + k] += f[k]
+                    ws[par, W_ACC + 9 + k] += nm[k]
+                L = (zero, zero, zero)
+                K = (zero, zero, zero)
+                f = (zero, zero, zero)
+                nm = (zero, zero, zero)
+        else:
+            L = (zero, zero, zero)
+            K = (zero, zero, zero)
+            f = (zero, zero, zero)
+            nm = (zero, zero, zero)
     return matrix_status(out)

@@ -19,16 +19,21 @@ One forward pass, base to tip: each link's kinematics in its own axes
 give its 6 x 10 block (the wrench each inertial parameter causes), which
 the one force carry (``force_to_parent``) takes to frame 0; each joint
 then takes the moment about (revolute) or the force along (prismatic) its
-axis of the links it carries.  The drive columns (viscous, Coulomb,
-offset, armature) follow the 10n inertial ones when asked for.  Its row
+axis of the links it carries: on a tree, its descendants (the columns of
+the other links are zero), and a mimic joint's share goes to its lead
+coordinate times its multiplier (Y = G^T Y_b, ten columns per body).
+The drive columns (viscous, Coulomb, offset, armature) follow the 10nb
+inertial ones when asked for.  Its row
 step is ``entry.regressor_row``, its batch loop ``run_regressor_batch``
 is written from it (``generate.batch``); ``core.regressor`` is the API.
 """
 import math
 
 from ._jit import njit
-from .kinematics import joint_trig, link_geometry, revolute
-from .layout import C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY
+from .kinematics import (branch_point, has_mimic, joint_rate, joint_trig,
+                         link_geometry, parent, revolute)
+from .layout import (C_ONE, C_ZERO, F_CONST, F_GRAV, L_BODY, L_LEAD, L_MULT,
+                     W_X)
 from .spatial import (cross, force_to_parent, load3, load9, matmul,
                       motion_to_child, rot, rot_t)
 
@@ -59,27 +64,46 @@ def _accel_to_child(R, p, w, al, ae):
 @njit(cache=True)
 def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
     """
-    Fill Y (n, >= 10n) with the inertial regressor at one state.
+    Fill Y (n, >= 10nb) with the inertial regressor at one state.
 
-    Scratch: ``ws`` (n, W_WIDTH) for the joints' trigonometry, ``line``
-    (n, 6) for each joint's axis as a line in frame 0, ``acc`` (10n, 6)
-    for each column's wrench in frame 0 (force, then moment about the
-    origin of frame 0).  Y's first 10n columns are overwritten.
+    Scratch: ``ws`` (nb, W_WIDTH) for the joints' trigonometry (and a
+    branch point's state, ``W_X``), ``line`` (nb, 6) for each joint's
+    axis as a line in frame 0, ``acc`` (10nb, 6) for each column's wrench
+    in frame 0 (force, then moment about the origin of frame 0).  Y's
+    first 10nb columns are overwritten.
     """
-    n = links.shape[0]
+    nb = links.shape[0]
+    n = Y.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
     two = one + one
-    ae = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    mimic = has_mimic(links, frames)
+    a_base = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
+    ae = a_base
     w = (zero, zero, zero)
     al = (zero, zero, zero)
     # pose of kernel frame j in frame 0
-    R0 = (one, zero, zero, zero, one, zero, zero, zero, one)
+    ident = (one, zero, zero, zero, one, zero, zero, zero, one)
+    R0 = ident
     o0 = (zero, zero, zero)
     # forward pass, base to tip: kinematics in kernel frame j, the link's
     # 6 x 10 block in link axes, then its columns in frame 0
     joint_trig(links, frames, q, ws)
-    for j in range(n):
+    for j in range(nb):
+        par = parent(links, j)
+        if par != j - 1:        # a branch: start from the parent's state
+            if par < 0:
+                R0 = ident
+                o0 = (zero, zero, zero)
+                w = (zero, zero, zero)
+                al = (zero, zero, zero)
+                ae = a_base
+            else:
+                R0 = load9(ws, par, W_X)
+                o0 = load3(ws, par, W_X + 9)
+                w = load3(ws, par, W_X + 12)
+                al = load3(ws, par, W_X + 15)
+                ae = load3(ws, par, W_X + 18)
         R, p = link_geometry(links, frames, j, ws)
         t = rot(R0, p[0], p[1], p[2])
         o0 = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
@@ -90,13 +114,22 @@ def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
         # (al, origin acceleration) carried into frame j, then the joint
         al, ae = _accel_to_child(R, p, w, al, ae)
         w = rot_t(R, w[0], w[1], w[2])
+        qdj = joint_rate(links, qd, j, mimic)
+        qddj = joint_rate(links, qdd, j, mimic)
         if revolute(links, frames, j):
-            al = (al[0] + w[1] * qd[j], al[1] - w[0] * qd[j],
-                  al[2] + qdd[j])
-            w = (w[0], w[1], w[2] + qd[j])
+            al = (al[0] + w[1] * qdj, al[1] - w[0] * qdj, al[2] + qddj)
+            w = (w[0], w[1], w[2] + qdj)
         else:
-            ae = (ae[0] + two * w[1] * qd[j], ae[1] - two * w[0] * qd[j],
-                  ae[2] + qdd[j])
+            ae = (ae[0] + two * w[1] * qdj, ae[1] - two * w[0] * qdj,
+                  ae[2] + qddj)
+        if branch_point(links, frames, j):
+            for k in range(9):
+                ws[j, W_X + k] = R0[k]
+            for k in range(3):
+                ws[j, W_X + 9 + k] = o0[k]
+                ws[j, W_X + 12 + k] = w[k]
+                ws[j, W_X + 15 + k] = al[k]
+                ws[j, W_X + 18 + k] = ae[k]
         # the link frame B in kernel frame j: kinematics in link axes
         RB = load9(links, j, L_BODY)
         pB = load3(links, j, L_BODY + 9)
@@ -139,21 +172,36 @@ def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
         _put(acc, col + 9, RL, oL, zz,
              _imom((zero, zero, a2), (zero, zero, w2), wl))      # Izz
     # each joint takes the moment about (revolute) or the force along
-    # (prismatic) its axis of the wrenches of the links it carries
-    for j in range(n):
-        for col in range(10 * j):
-            Y[j, col] = zero
-        z0, z1, z2 = line[j, 0], line[j, 1], line[j, 2]
-        if revolute(links, frames, j):
-            m0, m1, m2 = line[j, 3], line[j, 4], line[j, 5]
-            for col in range(10 * j, 10 * n):
-                Y[j, col] = (z0 * acc[col, 3] + z1 * acc[col, 4]
-                             + z2 * acc[col, 5] + m0 * acc[col, 0]
-                             + m1 * acc[col, 1] + m2 * acc[col, 2])
-        else:
-            for col in range(10 * j, 10 * n):
-                Y[j, col] = (z0 * acc[col, 0] + z1 * acc[col, 1]
-                             + z2 * acc[col, 2])
+    # (prismatic) its axis of the wrenches of the links it carries: link
+    # k's ten columns go to k and its ancestors, every other entry is zero
+    for r in range(n):
+        for col in range(10 * nb):
+            Y[r, col] = zero
+    for k in range(nb):
+        j = k
+        while j >= 0:
+            z0, z1, z2 = line[j, 0], line[j, 1], line[j, 2]
+            row = int(links[j, L_LEAD]) if mimic else j
+            s = links[j, L_MULT] if mimic else one
+            if revolute(links, frames, j):
+                m0, m1, m2 = line[j, 3], line[j, 4], line[j, 5]
+                for col in range(10 * k, 10 * k + 10):
+                    x = (z0 * acc[col, 3] + z1 * acc[col, 4]
+                         + z2 * acc[col, 5] + m0 * acc[col, 0]
+                         + m1 * acc[col, 1] + m2 * acc[col, 2])
+                    if mimic:
+                        Y[row, col] += s * x
+                    else:
+                        Y[row, col] = x
+            else:
+                for col in range(10 * k, 10 * k + 10):
+                    x = (z0 * acc[col, 0] + z1 * acc[col, 1]
+                         + z2 * acc[col, 2])
+                    if mimic:
+                        Y[row, col] += s * x
+                    else:
+                        Y[row, col] = x
+            j = parent(links, j)
 
 
 @njit(cache=True, inline='always')
@@ -170,12 +218,12 @@ def _imom(Ia, Iw, w):
 
 
 @njit(cache=True)
-def drive_columns(frames, qd, qdd, eps, Y):
-    """Fill the 4n drive columns after the 10n inertial ones of Y."""
+def drive_columns(links, frames, qd, qdd, eps, Y):
+    """Fill the 4n drive columns after the 10nb inertial ones of Y."""
     n = qd.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
-    base = 10 * n
+    base = 10 * links.shape[0]
     for j in range(n):
         for k in range(4 * n):
             Y[j, base + k] = zero

@@ -33,6 +33,16 @@ def first_nonfinite(x):
 
 
 @njit(cache=True, inline='always')
+def first_nonfinite_entry(X):
+    """Flat (row-major) index of the first non-finite entry of 2-D X, or -1."""
+    for i in range(X.shape[0]):
+        for k in range(X.shape[1]):
+            if not math.isfinite(X[i, k]):
+                return i * X.shape[1] + k
+    return -1
+
+
+@njit(cache=True, inline='always')
 def check_finite(q, qd, qdd, wrench):
     """-1 when all entries are finite, else 1000 * argument + index."""
     i = first_nonfinite(q)
