@@ -18,10 +18,12 @@ Per-call cost of two checkouts side by side (did a change cost time).
 
 BEFORE is another checkout of the repository (``git worktree add
 build/before COMMIT``).  Each round times the public single-state calls
-(τ, D, C, g and forward dynamics on the Puma and the Panda, minimum of
-60 × 2000 calls) once in a process importing BEFORE's package and once
-in one importing this one, alternately, so both see the same machine;
-the table keeps each figure's minimum over the rounds.  Each checkout
+(τ, D, C, g and forward dynamics on the Puma, the Panda and a random
+100-link chain, minimum of 60 × 2000 calls; 15 × 200 for the 100-link
+chain) and the batch calls (τ, D and forward dynamics of 100 Panda
+states) once in a process importing BEFORE's package and once in one
+importing this one, alternately, so both see the same machine; the
+table keeps each figure's minimum over the rounds.  Each checkout
 compiles into a numba cache of its own (under ``build/``).
 """
 import argparse
@@ -35,9 +37,12 @@ CHILD = r"""
 import json, timeit
 import numpy as np
 import newton_euler_ros.core as c
+from newton_euler_tools.accuracy.chains import random_chain
 out = {}
-for name in ('puma560', 'panda'):
-    arm = c.load_robot(name)
+for name in ('puma560', 'panda', 'chain100'):
+    arm = random_chain(100, seed=3) if name == 'chain100' else \
+        c.load_robot(name)
+    number, repeat = (200, 15) if name == 'chain100' else (2000, 60)
     ws = c.Workspace(arm)
     q, qd, qdd = np.random.default_rng(1).uniform(-1, 1, (3, arm.n))
     tau = c.inverse_dynamics(arm, q, qd, qdd, ws=ws)
@@ -48,10 +53,20 @@ for name in ('puma560', 'panda'):
         'g': lambda: c.gravity_torques(arm, q, ws=ws),
         'FD': lambda: c.forward_dynamics(arm, q, qd, tau, ws=ws),
     }
+    if name == 'panda':
+        Q, QD, QDD = np.random.default_rng(2).uniform(-1, 1, (3, 100, arm.n))
+        TAU = c.inverse_dynamics_batch(arm, Q, QD, QDD, ws=ws)
+        calls.update({
+            'tau x100': lambda: c.inverse_dynamics_batch(arm, Q, QD, QDD,
+                                                         ws=ws),
+            'D x100': lambda: c.mass_matrix_batch(arm, Q, ws=ws),
+            'FD x100': lambda: c.forward_dynamics_batch(arm, Q, QD, TAU,
+                                                        ws=ws)})
     for op, f in calls.items():
         f()
-        out[f'{name} {op}'] = min(timeit.repeat(f, number=2000,
-                                                repeat=60)) / 2000 * 1e9
+        n_, r_ = (number, repeat) if 'x100' not in op else (20, 30)
+        out[f'{name} {op}'] = min(timeit.repeat(f, number=n_,
+                                                repeat=r_)) / n_ * 1e9
 print(json.dumps(out))
 """
 
@@ -63,7 +78,8 @@ def measure(package_root, cache):
     """Run CHILD importing the package under ``package_root``."""
     env = dict(os.environ, NUMBA_CACHE_DIR=cache)
     env['PYTHONPATH'] = os.pathsep.join(
-        [os.path.join(package_root, 'newton_euler_ros')]
+        [os.path.join(package_root, 'newton_euler_ros'),
+         os.path.join(package_root, 'tools')]
         + [p for p in env.get('PYTHONPATH', '').split(os.pathsep) if p])
     proc = subprocess.run([sys.executable, '-c', CHILD], env=env,
                           capture_output=True, text=True, timeout=1200)
@@ -99,13 +115,13 @@ def main(argv=None):
             for k, v in runs.items()}
     print(f'ns per call from Python, minimum over {args.rounds} alternating '
           f'rounds; before = {args.before}')
-    print(f'{"call":16s} {"before":>8s} {"after":>8s}  change')
+    print(f'{"call":18s} {"before":>8s} {"after":>8s}  change')
     worst = -1e9
     for op, b in best['before'].items():
         a = best['after'][op]
         change = 100 * (a / b - 1)
         worst = max(worst, change)
-        print(f'{op:16s} {b:8.0f} {a:8.0f}  {change:+6.1f} %')
+        print(f'{op:18s} {b:8.0f} {a:8.0f}  {change:+6.1f} %')
     print(f'largest increase: {worst:+.1f} %')
     return 0
 

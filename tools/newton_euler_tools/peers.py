@@ -353,13 +353,19 @@ class PinocchioTree:
         return out
 
     def regressor(self, q, qd, qdd):
-        """pin.computeJointTorqueRegressor, rows and body columns ours."""
+        """
+        ``pin.computeJointTorqueRegressor``, rows and body columns ours.
+
+        It refuses mimic joints, so it runs on the mimic-free model at the
+        same motion (G q + o, G qd, G qdd), its rows mapped by G^T.
+        """
         pin = self.pin
-        m, d = self.model, self.data
+        m = self.full
         Y = pin.computeJointTorqueRegressor(
-            m, d, self.config(q), self.vector(qd), self.vector(qdd))
+            m, self.full_data, self.full_config(q), self.G @ qd,
+            self.G @ qdd)
         ids = {m.names[i]: i for i in range(1, m.njoints)}
         cols = np.concatenate([np.arange(10 * (ids[name] - 1),
                                          10 * ids[name])
                                for name in self.ours.moving_joints])
-        return Y[np.ix_(self.iv, cols)]
+        return self.G.T @ Y[:, cols]

@@ -17,7 +17,9 @@ The torque regressor: rigid-body torques are linear in the parameters.
 
     tau = Y(q, qd, qdd) pi
 
-``pi`` holds ten inertial parameters per link, in Pinocchio's order
+``pi`` holds ten inertial parameters per link (per body of a tree: each
+moving joint's link with what is fixed to it, ``model.moving_joints``
+order, mimic joints' bodies too), in Pinocchio's order
 (``Inertia.toDynamicParameters``)::
 
     m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz
@@ -35,13 +37,16 @@ the acceleration of its origin (gravity as an upward acceleration of the
 base); the link's wrench about its origin is linear in its ten
 parameters (a 6 x 10 block).  The backward pass accumulates these blocks
 instead of numbers: joint j takes the moment about (revolute) or the force
-along (prismatic) its axis of the wrenches of links j..n-1.  The blocks
+along (prismatic) its axis of the wrenches of the links it carries (j and
+its descendants; a mimic joint's share goes to its leader's row, times
+its multiplier).  The blocks
 are carried to frame 0 once, and each joint's share is the product with
 its axis as a line (z_j, o_j x z_j): six products per entry, O(n^2)
 entries.
 
-Drive columns (``drives=True``: Y is n x 14n, the 4n drive columns after
-the 10n inertial ones, four per joint j at 10n + 4j + k)::
+Drive columns (``drives=True``: Y is n x (10nb + 4n), the 4n drive
+columns after the 10nb inertial ones, four per coordinate j at
+10nb + 4j + k; on a model without mimic joints nb = n, 14n columns)::
 
     k = 0  viscous friction F_v        column qd_j
     k = 1  Coulomb friction F_c        column tanh(qd_j / eps)
@@ -98,8 +103,14 @@ def _states(model, name, X, m=None):
 
 
 def n_parameters(model, drives=False):
-    """Return the number of columns of Y: 10n, or 14n with drives."""
-    return model.n * (N_INERTIAL + (N_DRIVE if drives else 0))
+    """
+    Return the number of columns of Y: 10nb, or 10nb + 4n with drives.
+
+    Ten inertial parameters per body (nb moving joints, mimic ones too)
+    and four drive parameters per coordinate (n independent joints); on a
+    model without mimic joints nb = n.
+    """
+    return N_INERTIAL * model.nb + (N_DRIVE * model.n if drives else 0)
 
 
 def _width(eps):
@@ -113,10 +124,12 @@ def _width(eps):
 def regressor_batch(model, Q, QD, QDD, *, drives=False,
                     coulomb_width=COULOMB_WIDTH, out=None):
     """
-    Y at each row of the (m, n) states: an (m, n, 10n) array.
+    Y at each row of the (m, n) states: an (m, n, 10nb) array.
 
-    With ``drives=True`` (m, n, 14n): the drive columns follow (see the
-    module docstring).  One compiled loop, no Python work per state.
+    With ``drives=True`` (m, n, 10nb + 4n): the drive columns follow (see
+    the module docstring).  One compiled loop, no Python work per state.
+    Columns 10b..10b+9 are the parameters of body b (``model.moving_joints``
+    order); a mimic joint's body acts through its leader's row.
     """
     Q = _states(model, 'Q', Q)
     m = Q.shape[0]
@@ -130,10 +143,10 @@ def regressor_batch(model, Q, QD, QDD, *, drives=False,
           or out.dtype != np.float64 or not out.flags.c_contiguous):
         raise DynamicsInputError(
             f'out must be a C-contiguous float64 array of shape {shape}')
-    n = max(model.n, 1)
-    ws = np.empty((n, K.W_WIDTH))
-    line = np.empty((n, 6))
-    acc = np.empty((10 * n, 6))
+    nb = max(model.nb, 1)
+    ws = np.empty((nb, K.W_WIDTH))
+    line = np.empty((nb, 6))
+    acc = np.empty((10 * nb, 6))
     status = np.zeros(1, dtype=np.int64)
     row = K.run_regressor_batch(model.packed, Q, QD, QDD, bool(drives), eps,
                                 ws, line, acc, out, status)
@@ -145,7 +158,7 @@ def regressor_batch(model, Q, QD, QDD, *, drives=False,
 
 def regressor(model, q, qd, qdd, *, drives=False,
               coulomb_width=COULOMB_WIDTH):
-    """Y(q, qd, qdd) at one state: (n, 10n), or (n, 14n) with drives."""
+    """Y(q, qd, qdd) at one state: (n, 10nb), or (n, 10nb + 4n), drives."""
     return regressor_batch(model, q, qd, qdd, drives=drives,
                            coulomb_width=coulomb_width)[0]
 
@@ -192,10 +205,10 @@ def link_inertials(pi):
 
 
 def inertial_parameters(model):
-    """Return the model's 10n inertial parameters, link by link."""
+    """Return the model's 10nb inertial parameters, body by body."""
     return np.concatenate([
         link_parameters(model.mass[j], model.com[j], model.inertia[j])
-        for j in range(model.n)]) if model.n else np.zeros(0)
+        for j in range(model.nb)]) if model.nb else np.zeros(0)
 
 
 def pseudo_inertia(pi):
@@ -212,10 +225,10 @@ def pseudo_inertia(pi):
 
 
 def with_parameters(model, pi):
-    """Return a copy of ``model`` with the 10n inertial parameters ``pi``."""
-    pi = np.asarray(pi, dtype=np.float64).reshape(model.n, N_INERTIAL)
+    """Return a copy of ``model`` with the 10nb inertial parameters ``pi``."""
+    pi = np.asarray(pi, dtype=np.float64).reshape(model.nb, N_INERTIAL)
     mass, com, inertia = [], [], []
-    for j in range(model.n):
+    for j in range(model.nb):
         m, c, Ic = link_inertials(pi[j])
         mass.append(m)
         com.append(c)

@@ -62,7 +62,7 @@ class SceneDynamics(EffectDynamics):
         if self.effects.gravity:
             poses = link_poses(self.model, q, ws=self.ws)
             g = self.model.gravity
-            for j in range(self.model.n):
+            for j in range(self.model.nb):      # every body of a tree
                 c = poses[j + 1, :3, :3] @ self.model.com[j] + \
                     poses[j + 1, :3, 3]
                 U -= self.model.mass[j] * (g @ c)

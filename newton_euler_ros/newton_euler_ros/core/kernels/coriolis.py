@@ -24,7 +24,7 @@ from .kinematics import (body_inertia, branch_point, branched, has_mimic,
                          joint_rate, joint_trig, link_geometry, parent,
                          put_pair, revolute, zero_matrix)
 from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_ICA,
-                     CW_OW, CW_RW, CW_S, CW_SD, CW_V, F_CONST)
+                     CW_OW, CW_RW, CW_S, CW_SD, CW_V, F_CONST, OVERFLOW)
 from .spatial import cross, load3, load9, mat6_vec, matmul, rot, skew, vec6
 from .status import matrix_status
 
@@ -196,8 +196,11 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
     joint_trig(links, frames, q, ws)
     coriolis_forward(links, frames, qd, ws, cw)
     coriolis_backward(links, frames, cw)
-    if mimic or branched(frames):
+    tree = branched(frames)
+    if mimic or tree:
         zero_matrix(frames, C)
+    zero = frames[F_CONST, C_ZERO]
+    check = zero        # zero times each entry: zero unless one is not finite
     for a in range(nb):
         f10 = cw[a, CW_F1]
         f11 = cw[a, CW_F1 + 1]
@@ -211,14 +214,10 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
         f23 = cw[a, CW_F2 + 3]
         f24 = cw[a, CW_F2 + 4]
         f25 = cw[a, CW_F2 + 5]
-        g0 = cw[a, CW_G]
-        g1 = cw[a, CW_G + 1]
-        g2 = cw[a, CW_G + 2]
-        g3 = cw[a, CW_G + 3]
-        g4 = cw[a, CW_G + 4]
-        g5 = cw[a, CW_G + 5]
-        b = a
-        while b >= 0:       # a itself, then its ancestors
+        # row a left of the diagonal: b = a, then a's ancestors (on a
+        # chain every b < a, in order, row a written contiguously)
+        b = a if tree else 0
+        while b >= 0:
             x = ((f10 * cw[b, CW_SD] + f11 * cw[b, CW_SD + 1]
                   + f12 * cw[b, CW_SD + 2] + f13 * cw[b, CW_SD + 3]
                   + f14 * cw[b, CW_SD + 4] + f15 * cw[b, CW_SD + 5])
@@ -226,10 +225,41 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
                     + f22 * cw[b, CW_S + 2] + f23 * cw[b, CW_S + 3]
                     + f24 * cw[b, CW_S + 4] + f25 * cw[b, CW_S + 5]))
             put_pair(links, C, a, b, x, mimic)
-            if b != a:
+            check = check + zero * x
+            if tree:
+                b = parent(links, b)
+            else:
+                b = b + 1 if b < a else -1
+        # column a above the diagonal, C[b, a] = S_b . G_a for a's
+        # ancestors b; on a chain row a right of it, C[a, b] = S_a . G_b
+        if tree:
+            g0 = cw[a, CW_G]
+            g1 = cw[a, CW_G + 1]
+            g2 = cw[a, CW_G + 2]
+            g3 = cw[a, CW_G + 3]
+            g4 = cw[a, CW_G + 4]
+            g5 = cw[a, CW_G + 5]
+            b = parent(links, a)
+            while b >= 0:
                 x = (cw[b, CW_S] * g0 + cw[b, CW_S + 1] * g1
                      + cw[b, CW_S + 2] * g2 + cw[b, CW_S + 3] * g3
                      + cw[b, CW_S + 4] * g4 + cw[b, CW_S + 5] * g5)
                 put_pair(links, C, b, a, x, mimic)
-            b = parent(links, b)
-    return matrix_status(C)
+                check = check + zero * x
+                b = parent(links, b)
+        else:
+            s0 = cw[a, CW_S]
+            s1 = cw[a, CW_S + 1]
+            s2 = cw[a, CW_S + 2]
+            s3 = cw[a, CW_S + 3]
+            s4 = cw[a, CW_S + 4]
+            s5 = cw[a, CW_S + 5]
+            for b in range(a + 1, nb):
+                x = (s0 * cw[b, CW_G] + s1 * cw[b, CW_G + 1]
+                     + s2 * cw[b, CW_G + 2] + s3 * cw[b, CW_G + 3]
+                     + s4 * cw[b, CW_G + 4] + s5 * cw[b, CW_G + 5])
+                put_pair(links, C, a, b, x, mimic)
+                check = check + zero * x
+    if mimic:       # sums of finite entries may still overflow
+        return matrix_status(C)
+    return -1 if check == zero else OVERFLOW

@@ -18,7 +18,7 @@ from .kinematics import (branch_point, branched, has_mimic, joint_trig,
                          parent, placement, put_pair, revolute,
                          stored_placement, zero_matrix)
 from .layout import (C_HALF, C_ZERO, F_CONST, L_COM, L_INERTIA, L_MASS,
-                     W_ACC)
+                     OVERFLOW, W_ACC)
 from .spatial import force_to_parent, rot, sym_rotate
 from .status import matrix_status
 
@@ -86,6 +86,9 @@ def mass_matrix_crba(links, frames, q, ws, D):
     Mc = zero
     h = (zero, zero, zero)
     Io = (zero, zero, zero, zero, zero, zero)
+    # zero times each entry: stays zero unless one is inf or nan (cheaper
+    # than a pass over all n^2 entries, most of them zero on a tree)
+    check = zero
     for i in range(nb - 1, -1, -1):
         if branch_point(links, frames, i):      # the later children's
             a = W_ACC
@@ -118,10 +121,12 @@ def mass_matrix_crba(links, frames, q, ws, D):
             F = (-h[1], h[0], zero)
             N = (Io[5], Io[4], Io[2])
             put_pair(links, D, i, i, N[2], mimic)
+            check = check + zero * N[2]
         else:
             F = (zero, zero, Mc)
             N = (h[1], -h[0], zero)
             put_pair(links, D, i, i, F[2], mimic)
+            check = check + zero * F[2]
         # ---- carry it to the base, joint by joint up the support ----
         k = i
         j = parent(links, i)
@@ -134,6 +139,7 @@ def mass_matrix_crba(links, frames, q, ws, D):
                 x = F[2]
             put_pair(links, D, j, i, x, mimic)
             put_pair(links, D, i, j, x, mimic)
+            check = check + zero * x
             k = j
             j = parent(links, j)
         # ---- the composite in its parent's frame, about its origin ----
@@ -168,4 +174,6 @@ def mass_matrix_crba(links, frames, q, ws, D):
             Mc = zero
             h = (zero, zero, zero)
             Io = (zero, zero, zero, zero, zero, zero)
-    return matrix_status(D)
+    if mimic:       # sums of finite entries may still overflow
+        return matrix_status(D)
+    return -1 if check == zero else OVERFLOW
