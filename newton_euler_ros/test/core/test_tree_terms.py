@@ -33,13 +33,12 @@ from newton_euler_ros.core import (coriolis_matrix, forward_dynamics,
                                    inverse_dynamics, inverse_dynamics_batch,
                                    jacobian, load_robot, load_urdf,
                                    mass_matrix, mass_matrix_batch,
-                                   wrench_torques, Workspace)
+                                   Workspace, wrench_torques)
 from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core.errors import DynamicsInputError
 from newton_euler_ros.core.float32 import Float32Dynamics
 from newton_euler_ros.core.regressor import (inertial_parameters,
-                                             n_parameters, regressor,
-                                             regressor_batch)
+                                             n_parameters, regressor)
 from newton_euler_ros.core.robot_file import RobotFileWarning
 import numpy as np
 import pytest
