@@ -63,3 +63,9 @@ def test_benchmark_runs(tmp_path):
     data = json.loads(out.read_text())
     (robot,) = data['robots']
     assert set(robot['verdicts']) == set(bench.OPS)
+    # the whole-robot rows: Centauro's tree against Pinocchio, checked
+    (tree,) = data['trees']
+    assert (tree['robot'], tree['dof']) == ('centauro', 39)
+    assert tree['valid'] is True
+    assert {op for op, v in tree['verdicts'].items()
+            if v['verdict'] in ('PASS', 'MISS')} == {'tau', 'D', 'FD'}

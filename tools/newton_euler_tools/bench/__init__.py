@@ -40,6 +40,10 @@ For each robot (default: the bundled ``puma560`` and ``panda``) it
    and batched D, C, g and forward dynamics <= 0.5x a Python loop of the
    matching Pinocchio function, per state.
 
+Then the whole robots (:mod:`.trees`, default Centauro's 39 joints,
+``--tree NAME``): a model of the whole URDF tree against Pinocchio's of
+the same file, tau, D and forward dynamics each <= 0.8x its Python call.
+
 Peers are optional: a missing library is reported and skipped.
 
 The package: :mod:`.prepare` (the rows, as one statement each, their
@@ -68,6 +72,7 @@ from .references import check_references, naive_mass_matrix, naive_rnea
 from .report import (json_default, jsonable, loadavg, print_breakdown,
                      print_first_call, print_inputs, print_misses,
                      print_table, verdicts)
+from .trees import bench_tree, DEFAULT_TREES, print_tree_table, TREES
 from .. import peers
 
 __all__ = ['BATCH_STATES', 'BATCHES', 'bench_robot', 'DEFAULT_ROBOTS',
@@ -102,6 +107,11 @@ def main(argv=None):
     parser.add_argument('--robot', action='append', metavar='NAME',
                         help='robot to benchmark (repeatable; default: '
                              + ', '.join(DEFAULT_ROBOTS) + ')')
+    parser.add_argument('--tree', action='append', metavar='NAME',
+                        choices=sorted(TREES) + ['none'],
+                        help='whole robot (URDF tree) to benchmark '
+                             '(repeatable; default: '
+                             + ', '.join(DEFAULT_TREES) + '; none: skip)')
     parser.add_argument('--seed', type=int, default=12345,
                         help='seed of the random states (default 12345)')
     args = parser.parse_args(argv)
@@ -129,6 +139,8 @@ def main(argv=None):
     try:
         results = [bench_robot(name, timer, rng, log)
                    for name in robots]
+        trees = [bench_tree(name, timer, rng, log)
+                 for name in (args.tree or DEFAULT_TREES) if name != 'none']
     except NewtonEulerError as exc:
         print(f'error: {exc}', file=sys.stderr)
         return 2
@@ -152,11 +164,16 @@ def main(argv=None):
         print_inputs(result, log)
         print_breakdown(result, log)
         print_misses(result, log)
+    for tree in trees:
+        print_tree_table(tree, timer, log)
     print_first_call(first, log)
 
     log('\ntargets: ' + '; '.join(
-        f'{r["robot"]} ' + ', '.join(f'{op} {r["verdicts"][op]["verdict"]}'
-                                     for op in OPS) for r in results))
+        [f'{r["robot"]} ' + ', '.join(f'{op} {r["verdicts"][op]["verdict"]}'
+                                      for op in OPS) for r in results]
+        + [f'{t["robot"]} tree ' + ', '.join(
+            f'{op} {v["verdict"]}' for op, v in t['verdicts'].items()
+            if v['verdict'] != '-') for t in trees]))
     elapsed = time.perf_counter() - t_start
     load_end = loadavg()
     if load_end is not None:
@@ -169,7 +186,8 @@ def main(argv=None):
                    'seed': args.seed, 'batch_states': BATCH_STATES,
                    'targets': TARGETS,
                    'first_call': first, 'elapsed_s': elapsed,
-                   'robots': [jsonable(r) for r in results]}
+                   'robots': [jsonable(r) for r in results],
+                   'trees': [jsonable(t) for t in trees]}
         with open(args.json, 'w') as fh:
             json.dump(payload, fh, indent=1, default=json_default)
         log(f'wrote {args.json}')
