@@ -407,8 +407,8 @@ def load_robot(name_or_path, base=None, tip=None):
     """
     Load a robot: a YAML file, a bundled name (``'puma560'``) or a URDF.
 
-    A ``.urdf`` file gives the chain from ``base`` to ``tip`` (defaults:
-    the root link, and the single leaf below it); see
+    A ``.urdf`` file gives the whole tree below ``base`` (default: the
+    root link), or with ``tip`` the chain from ``base`` to ``tip``; see
     :mod:`newton_euler_ros.core.urdf`.  Warnings are issued as
     :class:`RobotFileWarning`; notes on data accepted as published (the
     Puma 560's inertias that break the triangle inequality) are not: they

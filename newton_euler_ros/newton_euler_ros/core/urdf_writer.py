@@ -53,9 +53,13 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
     is Post_k applied to the centre of mass, with Post_k's rotation; joint
     k's origin is Post_{k-1} Pre_k (the base pose for k = 1).  The end
     effector is a fixed link ``tool_link``.  Loading the text back gives
-    the same dynamics (the tests check tau, D, C, g and J).
+    the same dynamics (the tests check tau, D, C, g and J).  A tree is
+    written as one: joint k's parent link is that of ``model.parents[k]``
+    (Post of that joint, the base pose on the base), a mimic joint gets
+    its ``<mimic>``, and a model without an end effector no tool link.
     """
-    n = model.n
+    n = model.nb
+    names = model.moving_joints
     link_names = [f'link{k + 1}' for k in range(n)]
     lines = ['<?xml version="1.0"?>',
              f'<!-- {model.name}: written by newton-euler urdf from a '
@@ -63,15 +67,17 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
              f'{_fmt(model.gravity)} m/s^2 -->',
              f'<robot name="{model.name}">',
              f'  <link name="{base_link}"/>']
-    prev_post = np.asarray(model.base, dtype=float)
+    base = np.asarray(model.base, dtype=float)
+    posts = [model.joint_post_matrix(k) for k in range(n)]
     for k in range(n):
-        post = model.joint_post_matrix(k)
-        origin = prev_post @ model.joint_pre_matrix(k)
+        post = posts[k]
+        p = model.parents[k]
+        origin = (posts[p] if p >= 0 else base) @ model.joint_pre_matrix(k)
         lim = model.limits[k] if k < len(model.limits) else {}
         kind = model.joint_types[k]
         if kind == REVOLUTE and not ('lower' in lim and 'upper' in lim):
             kind = 'continuous'
-        parent = base_link if k == 0 else link_names[k - 1]
+        parent = base_link if p < 0 else link_names[p]
         inertia = np.asarray(model.inertia[k])
         com = post[:3, :3] @ model.com[k] + post[:3, 3]
         inertial_pose = np.eye(4)
@@ -88,7 +94,7 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
                     ('iyy', 1, 1), ('iyz', 1, 2), ('izz', 2, 2))) + '/>',
             '    </inertial>',
             '  </link>',
-            f'  <joint name="{model.joint_names[k]}" type="{kind}">',
+            f'  <joint name="{names[k]}" type="{kind}">',
             f'    <parent link="{parent}"/>',
             f'    <child link="{link_names[k]}"/>',
             _origin_xml(origin, '    '),
@@ -97,14 +103,22 @@ def model_to_urdf(model, base_link='base_link', tool_link='tool0'):
                  if key in lim and kind != 'continuous']
         attrs += [f'{key}="{_fmt([lim.get(key, 0.0)])}"'
                   for key in ('effort', 'velocity')]
-        lines += [f'    <limit {" ".join(attrs)}/>', '  </joint>']
-        prev_post = post
-    lines += [f'  <link name="{tool_link}"/>',
-              f'  <joint name="{tool_link}_joint" type="fixed">',
-              f'    <parent link="{link_names[-1]}"/>',
-              f'    <child link="{tool_link}"/>',
-              _origin_xml(prev_post @ np.asarray(model.tool, dtype=float),
-                          '    '),
-              '  </joint>',
-              '</robot>', '']
+        lines.append(f'    <limit {" ".join(attrs)}/>')
+        if model.mimic[k] is not None:
+            leader, mult, offset = model.mimic[k]
+            lines.append(f'    <mimic joint="{names[leader]}" multiplier='
+                         f'"{_fmt([mult])}" offset="{_fmt([offset])}"/>')
+        lines.append('  </joint>')
+    b = model.tool_body
+    if b is not None:
+        on = posts[b] if b >= 0 else base
+        lines += [f'  <link name="{tool_link}"/>',
+                  f'  <joint name="{tool_link}_joint" type="fixed">',
+                  f'    <parent link="'
+                  f'{link_names[b] if b >= 0 else base_link}"/>',
+                  f'    <child link="{tool_link}"/>',
+                  _origin_xml(on @ np.asarray(model.tool, dtype=float),
+                              '    '),
+                  '  </joint>']
+    lines += ['</robot>', '']
     return '\n'.join(lines)

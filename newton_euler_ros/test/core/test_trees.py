@@ -394,3 +394,18 @@ def test_continuous_leader_follower_angles():
     assert (np.linalg.inv(ra2) @ T[6])[1, 3] == pytest.approx(0.2)
     assert (np.linalg.inv(ra2) @ T[7])[1, 3] == pytest.approx(0.7)
     assert math.isfinite(float(gravity_torques(model, q)[5]))
+
+
+def test_a_tree_written_as_urdf_reads_back_the_same():
+    from newton_euler_ros.core import model_to_urdf
+    model = random_tree(31, links=9)
+    back = quiet(load_urdf, model_to_urdf(model))
+    assert back.joint_names == model.joint_names
+    assert back.parents == model.parents
+    assert [m is None for m in back.mimic] == [m is None for m in model.mimic]
+    rng = np.random.default_rng(8)
+    q, qd, qdd = rng.uniform(-1, 1, (3, model.n))
+    for f in (lambda m: inverse_dynamics(m, q, qd, qdd),
+              lambda m: mass_matrix(m, q),
+              lambda m: coriolis_matrix(m, q, qd)):
+        assert rel(f(back), f(model)) < 1e-13
