@@ -199,9 +199,13 @@ def node_help(node_name):
         doc = ast.get_docstring(ast.parse(fh.read())) or node_name
     lines = [f'usage: {node_name} [-h] [--ros-args [-p NAME:=VALUE]... '
              f'[--params-file FILE]... [-r FROM:=TO]...]', '', doc, '',
-             'Parameters (-p NAME:=VALUE, or --params-file FILE with a',
-             f'section {node_name}: or /**:; an unknown name stops the '
-             f'node):']
+             *textwrap.wrap(
+                 f'Parameters (-p NAME:=VALUE, or --params-file FILE with '
+                 f'a section {node_name}: or /**:; an unknown name stops '
+                 f"the node; ROS 2's own are accepted: use_sim_time, "
+                 f'start_type_description_service and qos_overrides.TOPIC.'
+                 f"publisher|subscription.POLICY, applied to the node's "
+                 f'topics):', 78)]
     for spec in load_specs(node_name):
         flags = ', read-only' if spec.read_only else ''
         lines.append(f'  {spec.name} ({spec.type}, default '

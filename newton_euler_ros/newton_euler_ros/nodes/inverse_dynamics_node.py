@@ -46,7 +46,6 @@ from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
@@ -54,7 +53,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
                      declare_parameters, plain, qos_profile, QUIET,
-                     release_memory, run_node)
+                     release_memory, run_node, SharedGraphNode)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
@@ -83,7 +82,7 @@ def _seconds(stamp):
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-class InverseDynamicsNode(Node):
+class InverseDynamicsNode(SharedGraphNode):
     """Feedforward torques from joint states, by Newton-Euler."""
 
     def __init__(self, **kwargs):

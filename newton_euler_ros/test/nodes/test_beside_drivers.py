@@ -1,0 +1,192 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+The nodes in a real robot graph, as processes over DDS.
+
+A robot bringup shares one parameter file among its nodes (a ``/**:``
+section with ``use_sim_time`` and ``qos_overrides``): every node of the
+package starts with it, and inverse_dynamics_node applies it (its
+``joint_states`` subscription best effort as the graph sees it, its clock
+the simulated ``/clock``).  The node's own parameters are still checked
+for typos, and a bad QoS override is one line.
+"""
+import os
+import sys
+import time
+
+import pytest
+import yaml
+
+pytest.importorskip('rclpy')
+
+from builtin_interfaces.msg import Time  # noqa: E402, I100
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from rclpy.qos import (QoSProfile, ReliabilityPolicy)  # noqa: E402
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe, ros_env)
+from rosgraph_msgs.msg import Clock  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+DOMAIN = domain_id(61)
+NODE = '/inverse_dynamics_node'
+PUMA_JOINTS = [f'joint{k}' for k in range(1, 7)]
+SCENE = 'puma_payload_press'
+
+
+def script(node):
+    return os.path.join(os.path.dirname(sys.executable), node)
+
+
+def shared_params(tmp_path, use_sim_time, extra=None):
+    """Write a bringup's shared parameter file: one ``/**:`` section."""
+    params = {
+        'use_sim_time': use_sim_time,
+        'start_type_description_service': True,
+        'qos_overrides': {
+            '/joint_states': {
+                'subscription': {'reliability': 'best_effort', 'depth': 3},
+                'publisher': {'depth': 50}},
+            '/tracking_controller_node/commands': {
+                'publisher': {'depth': 20}},
+            '/tf': {'publisher': {'durability': 'volatile'}}},
+        **(extra or {})}
+    path = tmp_path / 'shared.yaml'
+    path.write_text(yaml.safe_dump({'/**': {'ros__parameters': params}}))
+    return str(path)
+
+
+def wait_for(node, text, timeout=90.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if text in node.log():
+            return node.log()
+        assert node.alive(), node.log()
+        time.sleep(0.2)
+    raise AssertionError(f'no {text!r} in:\n{node.log()}')
+
+
+def test_shared_params_file_is_applied(tmp_path):
+    """
+    use_sim_time and the joint_states QoS override take effect.
+
+    With ``joint_states.max_age: 0.5`` a joint state stamped at 1000 s is
+    answered only if the node's clock is the simulated one the probe
+    publishes on /clock (against the wall clock it is 55 years old), and
+    the graph shows the node's joint_states subscription best effort
+    (the node's own qos.reliability is reliable).
+    """
+    shared = shared_params(tmp_path, use_sim_time=True)
+    probe = Probe(DOMAIN)
+    node = NodeProcess(id_node_cmd('puma560.yaml', '--params-file', shared,
+                                   '-p', 'joint_states.max_age:=0.5'),
+                       DOMAIN, str(tmp_path / 'node.log'))
+    try:
+        clock = probe.node.create_publisher(Clock, '/clock', 10)
+        js = probe.node.create_publisher(
+            JointState, 'joint_states',
+            QoSProfile(depth=10, reliability=ReliabilityPolicy.BEST_EFFORT))
+        torques = probe.collect(JointState, f'{NODE}/torques')
+        diagnostics = probe.collect(DiagnosticArray, '/diagnostics')
+
+        def ours():
+            return [info for info in probe.node.get_subscriptions_info_by_topic(
+                '/joint_states') if info.node_name == NODE[1:]]
+        assert probe.spin_until(lambda: ours() and js.get_subscription_count()
+                                and 'puma560 (' in node.log(), 90.0), \
+            node.log()
+        [info] = ours()
+        assert info.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
+        log = node.log()
+        assert 'qos_overrides: /joint_states.subscription: depth 3, ' \
+            'reliability best_effort' in log, log
+        assert 'unknown parameter' not in log and 'WARN' not in log, log
+
+        sim = 1000.0
+        answer = None
+        for seq in range(1, 200):
+            sim += 0.01
+            now = Time(sec=int(sim), nanosec=int(round(sim % 1 * 1e9)))
+            clock.publish(Clock(clock=now))
+            probe.spin_for(0.01)
+            stamp = Time(sec=now.sec, nanosec=now.nanosec + seq % 1000)
+            js.publish(joint_state(PUMA_JOINTS, [0.1] * 6, [0.0] * 6, stamp))
+            answer = probe.answer(torques, stamp, 0.05)
+            if answer is not None and len(diagnostics) > 0:
+                break
+        assert answer is not None, node.log()
+        # the diagnostics timer runs on the simulated clock too
+        assert probe.spin_until(lambda: len(diagnostics) > 0, 5.0)
+        counts = {kv.key: kv.value for kv in diagnostics[-1].status[0].values}
+        assert counts['stale'] == '0' and counts['bad_stamp'] == '0', counts
+    finally:
+        code = node.stop()
+        probe.close()
+    assert code == 0, node.log()
+
+
+@pytest.mark.parametrize('cmd, applied', [
+    ([script('robot_sim_node'), '--ros-args', '-p', f'scene:={SCENE}',
+      '-p', 'wait_for_controller:=false'],
+     'qos_overrides: /joint_states.publisher: depth 50'),
+    ([script('tracking_controller_node'), '--ros-args', '-p',
+      f'scene:={SCENE}'],
+     'qos_overrides: /tracking_controller_node/commands.publisher: '
+     'depth 20'),
+    (id_node_cmd('puma560.yaml'),
+     'qos_overrides: /joint_states.subscription: depth 3, '
+     'reliability best_effort'),
+], ids=['robot_sim_node', 'tracking_controller_node',
+        'inverse_dynamics_node'])
+def test_every_node_starts_with_the_shared_file(cmd, applied, tmp_path):
+    node = NodeProcess([*cmd, '--params-file',
+                        shared_params(tmp_path, use_sim_time=False)],
+                       DOMAIN, str(tmp_path / 'node.log'))
+    try:
+        wait_for(node, applied)
+        time.sleep(1.0)
+        assert node.alive(), node.log()
+    finally:
+        code = node.stop()
+    assert code == 0, node.log()
+    assert 'unknown parameter' not in node.log(), node.log()
+
+
+def run(cmd):
+    import subprocess
+    return subprocess.run(cmd, env=ros_env(DOMAIN), capture_output=True,
+                          text=True, timeout=120)
+
+
+@pytest.mark.parametrize('extra, message', [
+    ({'robot_flie': 'puma560'},
+     "unknown parameter 'robot_flie' (did you mean 'robot_file'?)"),
+    ({'qos_overrides': {'/joint_states': {'subscription': {
+        'reliability': 'sure'}}}},
+     'qos_overrides./joint_states.subscription.reliability: Unexpected QoS '
+     'override for policy `reliability`: `sure`'),
+    ({'qos_overrides': {'/joint_states': {'subscription': {'depth': 0}}}},
+     'qos_overrides./joint_states.subscription.depth: depth must be >= 1 '
+     'with history keep_last, got 0'),
+])
+def test_typos_and_bad_overrides_still_stop_the_node(extra, message,
+                                                     tmp_path):
+    shared = shared_params(tmp_path, use_sim_time=False, extra=extra)
+    proc = run(id_node_cmd('puma560.yaml', '--params-file', shared))
+    assert proc.returncode == 2, proc.stderr
+    lines = [x for x in proc.stderr.splitlines() if not x.startswith('[')]
+    assert lines == [f'inverse_dynamics_node: invalid configuration: '
+                     f'{message}'], proc.stderr
