@@ -237,7 +237,10 @@ class InverseDynamicsNode(SharedGraphNode):
             + ('' if not self.params['drives.compensate'] else
                ', drive terms compensated' if ff.drives is not None else
                ', drives.compensate is on but the robot has no drive '
-               'terms'))
+               'terms')
+            + (', without g(q): the robot adds it '
+               '(robot_compensates_gravity)'
+               if ff.robot_compensates_gravity else ''))
 
     # ---- robot_description ----
     def _on_description(self, msg):
@@ -453,7 +456,9 @@ class InverseDynamicsNode(SharedGraphNode):
                         else (None, 'base'))
             efforts = trajectory_efforts(ff.model, msg.joint_names, points,
                                          w, frame, 'trajectory: ', ff.ws,
-                                         drives=ff.drives)
+                                         drives=ff.drives,
+                                         gravity=not
+                                         ff.robot_compensates_gravity)
         except NewtonEulerError as exc:
             self._reject('trajectory', InputRejected('malformed', str(exc)))
             return
@@ -527,6 +532,8 @@ class InverseDynamicsNode(SharedGraphNode):
             hardware_id=ff.model.name if ff is not None else '')
         model.values = [
             KeyValue(key='mode', value=self.mode),
+            KeyValue(key='robot_compensates_gravity', value=str(
+                self.params['robot_compensates_gravity']).lower()),
             KeyValue(key='payload.mass', value=repr(self.payload[0])),
             KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
             KeyValue(key='payload.inertia',

@@ -21,23 +21,32 @@ package starts with it, and inverse_dynamics_node applies it (its
 ``joint_states`` subscription best effort as the graph sees it, its clock
 the simulated ``/clock``).  The node's own parameters are still checked
 for typos, and a bad QoS override is one line.
+
+A Panda (Franka's torque interface adds gravity itself) with
+``robot_compensates_gravity``: the published torques are Pinocchio's
+C(q, qd) qd on the same published URDF, and trajectory efforts
+D qdd + C qd, while the service still reports g.
 """
 import os
 import sys
 import time
 
+import numpy as np
 import pytest
 import yaml
 
 pytest.importorskip('rclpy')
 
-from builtin_interfaces.msg import Time  # noqa: E402, I100
+from builtin_interfaces.msg import Duration, Time  # noqa: E402, I100
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from rclpy.qos import (QoSProfile, ReliabilityPolicy)  # noqa: E402
 from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
                          NodeProcess, Probe, ros_env)
 from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
+from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
+                                 JointTrajectoryPoint)
 
 pytestmark = pytest.mark.ros
 
@@ -190,3 +199,90 @@ def test_typos_and_bad_overrides_still_stop_the_node(extra, message,
     lines = [x for x in proc.stderr.splitlines() if not x.startswith('[')]
     assert lines == [f'inverse_dynamics_node: invalid configuration: '
                      f'{message}'], proc.stderr
+
+
+# ---------------------------------------------------------------------------
+# robot_compensates_gravity, against Pinocchio on a published Panda
+# ---------------------------------------------------------------------------
+PANDA = 'panda_description/urdf/panda.urdf'
+PANDA_JOINTS = [f'panda_joint{k}' for k in range(1, 8)]
+PANDA_TIP = 'panda_hand_tcp'
+
+
+@pytest.fixture(scope='module')
+def panda_peer():
+    from newton_euler_tools.peers import example_robot_urdf, PinocchioUrdf
+    path = example_robot_urdf(PANDA)
+    return path, PinocchioUrdf(path, PANDA_JOINTS, PANDA_TIP)
+
+
+def test_robot_compensates_gravity_against_pinocchio(panda_peer, tmp_path):
+    path, peer = panda_peer
+    pin, m, d = peer.pin, peer.model, peer.data
+    probe = Probe(DOMAIN)
+    node = NodeProcess(id_node_cmd(
+        None, '-p', f'robot_file:={path}', '-p', 'base_link:=panda_link0',
+        '-p', f'tip_link:={PANDA_TIP}', '-p', 'robot_compensates_gravity:=true'),
+        DOMAIN, str(tmp_path / 'node.log'))
+    try:
+        js = probe.publisher(JointState, 'joint_states')
+        torques = probe.collect(JointState, f'{NODE}/torques')
+        traj_in = probe.publisher(JointTrajectory, f'{NODE}/trajectory_in')
+        traj_out = probe.collect(JointTrajectory, f'{NODE}/trajectory_out')
+        assert probe.spin_until(
+            lambda: js.get_subscription_count() > 0
+            and traj_in.get_subscription_count() > 0
+            and traj_out is not None and 'panda (' in node.log(), 90.0), \
+            node.log()
+        assert 'without g(q): the robot adds it' in node.log()
+        rng = np.random.default_rng(28)
+        for seq in range(1, 6):
+            q = rng.uniform(-1.2, 1.2, 7)
+            qd = rng.uniform(-1.0, 1.0, 7)
+            stamp = probe.keyed_stamp(seq)
+            js.publish(joint_state(PANDA_JOINTS, q, qd, stamp))
+            answer = probe.answer(torques, stamp, 10.0)
+            assert answer is not None, node.log()
+            assert list(answer.name) == PANDA_JOINTS
+            x = peer.config(q)
+            coriolis = pin.computeCoriolisMatrix(m, d, x, qd) @ qd
+            gravity = pin.computeGeneralizedGravity(m, d, x)
+            assert np.abs(gravity).max() > 1.0      # g would be seen
+            assert np.allclose(answer.effort, coriolis, rtol=0,
+                               atol=1e-9), (answer.effort, coriolis)
+
+        # trajectory efforts: D qdd + C qd at every point
+        points = [(rng.uniform(-1.2, 1.2, 7), rng.uniform(-1.0, 1.0, 7),
+                   rng.uniform(-2.0, 2.0, 7)) for _ in range(4)]
+        msg = JointTrajectory(joint_names=PANDA_JOINTS)
+        for k, (q, qd, qdd) in enumerate(points):
+            msg.points.append(JointTrajectoryPoint(
+                positions=q.tolist(), velocities=qd.tolist(),
+                accelerations=qdd.tolist(),
+                time_from_start=Duration(sec=k, nanosec=0)))
+        traj_in.publish(msg)
+        assert probe.spin_until(lambda: len(traj_out) > 0, 10.0), node.log()
+        for (q, qd, qdd), point in zip(points, traj_out[0].points):
+            x = peer.config(q)
+            D = pin.crba(m, d, x)
+            D = np.triu(D) + np.triu(D, 1).T
+            expected = D @ qdd + pin.computeCoriolisMatrix(m, d, x, qd) @ qd
+            assert np.allclose(point.effort, expected, rtol=0, atol=1e-9)
+
+        # the service: tau without g, and g itself reported
+        q, qd, qdd = points[0]
+        reply = probe.call(ComputeDynamics, f'{NODE}/compute_dynamics',
+                           ComputeDynamics.Request(
+                               name=PANDA_JOINTS, position=q.tolist(),
+                               velocity=qd.tolist(),
+                               acceleration=qdd.tolist()))
+        assert reply.success, reply.message
+        x = peer.config(q)
+        assert np.allclose(reply.gravity,
+                           pin.computeGeneralizedGravity(m, d, x), atol=1e-9)
+        assert np.allclose(reply.torque, traj_out[0].points[0].effort,
+                           atol=1e-9)
+    finally:
+        code = node.stop()
+        probe.close()
+    assert code == 0, node.log()
