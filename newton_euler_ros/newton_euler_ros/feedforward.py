@@ -88,15 +88,25 @@ class JointOrder:
         self.to_output = np.array([index[j] for j in output], dtype=np.intp)
         self._cache_names = None
         self._cache_take = None
+        #: the last name list that held none of the model's joints
+        self._other_names = None
 
     @property
     def n(self):
         return len(self.model_joints)
 
     def _take(self, names):
-        """Return the indices into a message's arrays that give the model's order."""
+        """
+        Return the indices into a message's arrays that give the model's order.
+
+        A message that names none of the model's joints (another
+        publisher's on the same topic, e.g. a gripper driver's) raises
+        InputRejected of kind ``other_joints``.
+        """
         if names == self._cache_names:
             return self._cache_take
+        if names == self._other_names:
+            raise self._other_joints(names)
         where = {}
         for i, name in enumerate(names):
             if not name.isprintable():
@@ -109,6 +119,9 @@ class JointOrder:
                                     f'twice')
             where[name] = i
         missing = [j for j in self.model_joints if j not in where]
+        if names and len(missing) == len(self.model_joints):
+            self._other_names = list(names)
+            raise self._other_joints(names)
         if missing:
             known = set(self.model_joints)
             unknown = [clip(x, 60) for x in names if x not in known][:5]
@@ -120,6 +133,11 @@ class JointOrder:
         self._cache_names = list(names)
         self._cache_take = take
         return take
+
+    def _other_joints(self, names):
+        return InputRejected(
+            'other_joints', f"none of the robot's joints (it names "
+            f'{clip([clip(x, 60) for x in names[:8]], 300)})')
 
     def gather(self, names, field, values, required=True):
         """

@@ -71,7 +71,7 @@ COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'service_calls', 'service_failures', 'internal_error',
             'no_model', 'descriptions_loaded', 'descriptions_rejected',
             'trajectories', 'payload_changes', 'implausible', 'over_limit',
-            'oversized', 'bad_stamp')
+            'oversized', 'bad_stamp', 'other_joints')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -373,7 +373,12 @@ class InverseDynamicsNode(SharedGraphNode):
                     f'{ff.wrench.timeout} s; torques no longer include '
                     f'it'))
         except InputRejected as exc:
-            self._reject('joint state', exc)
+            if exc.kind == 'other_joints':
+                # another publisher on joint_states (a gripper driver's):
+                # normal in a robot graph, counted and not logged
+                self.counts['other_joints'] += 1
+            else:
+                self._reject('joint state', exc)
             return
         except Exception as exc:  # never let a message kill the node
             self._reject('joint state', exc)

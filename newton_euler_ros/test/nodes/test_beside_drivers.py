@@ -22,6 +22,11 @@ package starts with it, and inverse_dynamics_node applies it (its
 the simulated ``/clock``).  The node's own parameters are still checked
 for typos, and a bad QoS override is one line.
 
+A gripper driver publishing its own JointStates on ``joint_states``
+beside the arm's: its messages are counted in ``/diagnostics``
+(``other_joints``), not warned about, and the arm's torques keep coming
+at the arm's rate.
+
 A Panda (Franka's torque interface adds gravity itself) with
 ``robot_compensates_gravity``: the published torques are Pinocchio's
 C(q, qd) qd on the same published URDF, and trajectory efforts
@@ -199,6 +204,64 @@ def test_typos_and_bad_overrides_still_stop_the_node(extra, message,
     lines = [x for x in proc.stderr.splitlines() if not x.startswith('[')]
     assert lines == [f'inverse_dynamics_node: invalid configuration: '
                      f'{message}'], proc.stderr
+
+
+# ---------------------------------------------------------------------------
+# a gripper driver's joint states beside the arm's
+# ---------------------------------------------------------------------------
+GRIPPER = ['gripper_finger_joint1', 'gripper_finger_joint2']
+
+
+def test_gripper_joint_states_beside_the_arms(tmp_path):
+    probe = Probe(DOMAIN)
+    node = NodeProcess(id_node_cmd('puma560.yaml'), DOMAIN,
+                       str(tmp_path / 'node.log'))
+    try:
+        js = probe.publisher(JointState, 'joint_states')
+        torques = probe.collect(JointState, f'{NODE}/torques')
+        diagnostics = probe.collect(DiagnosticArray, '/diagnostics')
+        assert probe.spin_until(lambda: js.get_subscription_count() > 0
+                                and 'puma560 (' in node.log(), 90.0), \
+            node.log()
+        # the arm and the gripper at 100 Hz each, interleaved, for 2 s
+        arm_stamps = []
+        start = time.monotonic()
+        for seq in range(1, 401):
+            stamp = probe.keyed_stamp(seq)
+            if seq % 2:
+                arm_stamps.append(stamp)
+                js.publish(joint_state(PUMA_JOINTS, [0.1 * seq % 1.0] * 6,
+                                       [0.2] * 6, stamp))
+            else:
+                msg = joint_state(GRIPPER, [0.01, 0.01], [0.0, 0.0], stamp)
+                msg.effort = [5.0, 5.0]
+                js.publish(msg)
+            probe.spin_until(lambda: False,
+                             max(0.0, start + seq * 0.005 - time.monotonic()))
+        sent_for = time.monotonic() - start
+        probe.spin_until(lambda: len(torques) >= len(arm_stamps), 5.0)
+        answered = {(t.header.stamp.sec, t.header.stamp.nanosec)
+                    for t in torques}
+        arm = {(s.sec, s.nanosec) for s in arm_stamps}
+        assert answered <= arm          # no answer to a gripper message
+        # every arm message answered (reliable, 100 Hz), at the arm's rate
+        assert len(answered) >= 0.95 * len(arm), (len(answered), len(arm))
+        stamps = sorted(t.header.stamp.sec + t.header.stamp.nanosec * 1e-9
+                        for t in torques)
+        rate = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+        assert 80.0 < rate < 120.0, (rate, sent_for)
+        counts = probe.next_counters(diagnostics)
+        counts = probe.next_counters(diagnostics)
+        assert counts['other_joints'] >= 0.95 * 200, counts
+        assert counts['other_joints'] <= 200, counts
+        assert counts['missing_joints'] == 0, counts
+        assert counts['published'] == len(torques), counts
+    finally:
+        code = node.stop()
+        probe.close()
+    assert code == 0, node.log()
+    log = node.log()
+    assert 'WARN' not in log and 'dropped' not in log, log
 
 
 # ---------------------------------------------------------------------------
