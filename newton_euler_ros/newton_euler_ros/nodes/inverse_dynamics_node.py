@@ -94,6 +94,8 @@ class InverseDynamicsNode(SharedGraphNode):
         self._last_log = {}
         self.ff = None          # swapped whole when a new model arrives
         self.model_source = ''
+        #: why the last robot_description was rejected ('' when it loaded)
+        self.description_rejected = ''
         scene = None
         if p['mode'] in ('gravity', 'gravity_coriolis') and \
                 p['acceleration_source'] == 'reference':
@@ -257,22 +259,23 @@ class InverseDynamicsNode(SharedGraphNode):
                 text, 'robot_description', base=p['base_link'] or None,
                 tip=p['tip_link'] or None)
             ff = self._make_computer(model)
-        except (NewtonEulerError, ValueError) as exc:
+        except Exception as exc:  # never let a description kill the node
+            reason = clip(str(exc), 400)
+            if not isinstance(exc, (NewtonEulerError, ValueError)):
+                reason = f'internal error: {reason}'
             self.counts['descriptions_rejected'] += 1
+            with self._description_lock:
+                if seq == self._description_seq:    # the newest one
+                    self.description_rejected = reason
             keep = ('the previous model keeps working' if self.ff is not None
                     else 'still no model: publishing nothing')
             self.get_logger().error(
-                f'robot_description rejected: {clip(str(exc), 400)}; {keep}')
-            return
-        except Exception as exc:  # never let a description kill the node
-            self.counts['descriptions_rejected'] += 1
-            self.get_logger().error(
-                f'robot_description rejected (internal error): '
-                f'{clip(str(exc), 400)}')
+                f'robot_description rejected: {reason}; {keep}')
             return
         with self._description_lock:
             if seq != self._description_seq:
                 return          # a newer description is on its way
+            self.description_rejected = ''
             for message in found:
                 log = (self.get_logger().debug if isinstance(message, Note)
                        else self.get_logger().warning)
@@ -492,8 +495,7 @@ class InverseDynamicsNode(SharedGraphNode):
         if ff is None:
             self.counts['service_failures'] += 1
             response.success = False
-            response.message = ('no robot model yet (waiting for '
-                                'robot_description)')
+            response.message = self._no_model_text()
             return response
         try:
             D, C, g, tau = ff.terms(
@@ -519,15 +521,31 @@ class InverseDynamicsNode(SharedGraphNode):
         response.torque = tau.tolist()
         return response
 
+    def _no_model_text(self):
+        """Say why there is no model: waiting, or the description rejected."""
+        rejected = self.description_rejected
+        if rejected:
+            return (f'no robot model: robot_description rejected: '
+                    f'{rejected}')
+        return 'no robot model yet (waiting for robot_description)'
+
     def _publish_counts(self):
         release_memory()
         ff = self.ff
+        rejected = self.description_rejected
+        if ff is None:
+            level, message = (
+                DiagnosticStatus.ERROR if rejected else DiagnosticStatus.WARN,
+                f'{self._no_model_text()}: publishing nothing')
+        elif rejected:
+            level, message = DiagnosticStatus.WARN, (
+                f'input counters; the last robot_description was rejected '
+                f'({rejected}); the previous model keeps working')
+        else:
+            level, message = DiagnosticStatus.OK, 'input counters'
         status = DiagnosticStatus(
-            level=DiagnosticStatus.OK if ff is not None
-            else DiagnosticStatus.WARN,
-            name=self.get_fully_qualified_name(),
-            message=('input counters' if ff is not None else
-                     'waiting for robot_description: publishing nothing'),
+            level=level, name=self.get_fully_qualified_name(),
+            message=message,
             hardware_id=ff.model.name if ff is not None else '')
         status.values = [KeyValue(key=k, value=str(v))
                          for k, v in self.counts.items()]

@@ -27,6 +27,9 @@ beside the arm's: its messages are counted in ``/diagnostics``
 (``other_joints``), not warned about, and the arm's torques keep coming
 at the arm's rate.
 
+A rejected ``robot_description`` shows as rejected, with its reason, in
+``/diagnostics`` and in the service's answer (not as "waiting").
+
 A Panda (Franka's torque interface adds gravity itself) with
 ``robot_compensates_gravity``: the published torques are Pinocchio's
 C(q, qd) qd on the same published URDF, and trajectory efforts
@@ -45,11 +48,13 @@ pytest.importorskip('rclpy')
 from builtin_interfaces.msg import Duration, Time  # noqa: E402, I100
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
-from rclpy.qos import (QoSProfile, ReliabilityPolicy)  # noqa: E402
+from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
+                       ReliabilityPolicy)
 from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
                          NodeProcess, Probe, ros_env)
 from rosgraph_msgs.msg import Clock  # noqa: E402
 from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import String  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
                                  JointTrajectoryPoint)
 
@@ -262,6 +267,82 @@ def test_gripper_joint_states_beside_the_arms(tmp_path):
     assert code == 0, node.log()
     log = node.log()
     assert 'WARN' not in log and 'dropped' not in log, log
+
+
+# ---------------------------------------------------------------------------
+# a rejected robot_description
+# ---------------------------------------------------------------------------
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+ZERO_AXIS = ('<robot name="r"><link name="b"/><link name="a"/>'
+             '<joint name="j" type="revolute"><parent link="b"/>'
+             '<child link="a"/><axis xyz="0 0 0"/></joint></robot>')
+GOOD = ('<robot name="r"><link name="base_link"/><link name="a">'
+        '<inertial><mass value="1"/><origin xyz="0.1 0 0"/><inertia '
+        'ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/>'
+        '</inertial></link><link name="tool0"/>'
+        '<joint name="j" type="revolute"><parent link="base_link"/>'
+        '<child link="a"/><axis xyz="0 1 0"/><limit lower="-3" upper="3" '
+        'effort="50" velocity="2"/></joint><joint name="flange" '
+        'type="fixed"><parent link="a"/><child link="tool0"/></joint>'
+        '</robot>')
+REASON = "joint 'j' <axis> xyz: must be a nonzero vector, got 0 0 0"
+
+
+def test_a_rejected_description_says_so(tmp_path):
+    probe = Probe(DOMAIN)
+    node = NodeProcess(id_node_cmd('urdf.yaml'), DOMAIN,
+                       str(tmp_path / 'node.log'))
+    try:
+        description = probe.node.create_publisher(
+            String, 'robot_description', LATCHED)
+        diagnostics = probe.collect(DiagnosticArray, '/diagnostics')
+        assert probe.spin_until(
+            lambda: description.get_subscription_count() > 0, 90.0), \
+            node.log()
+
+        def status():
+            count = len(diagnostics)
+            assert probe.spin_until(lambda: len(diagnostics) > count, 5.0)
+            return diagnostics[-1].status[0]
+
+        def service():
+            return probe.call(ComputeDynamics, f'{NODE}/compute_dynamics',
+                              ComputeDynamics.Request(
+                                  name=['j'], position=[0.1]))
+        first = status()
+        assert 'waiting for robot_description' in first.message
+        description.publish(String(data=ZERO_AXIS))
+        assert probe.spin_until(lambda: 'rejected' in node.log(), 10.0)
+        rejected = status()
+        assert rejected.level == rejected.ERROR
+        assert 'robot_description rejected' in rejected.message
+        assert REASON in rejected.message, rejected.message
+        assert 'waiting' not in rejected.message
+        reply = service()
+        assert not reply.success
+        assert reply.message == ('no robot model: robot_description '
+                                 f'rejected: robot_description: {REASON}'), \
+            reply.message
+
+        # a good one loads and clears it; a bad one after it is a warning
+        description.publish(String(data=GOOD))
+        assert probe.spin_until(lambda: service().success, 20.0), node.log()
+        loaded = status()
+        assert loaded.level == loaded.OK and loaded.message == \
+            'input counters', loaded.message
+        description.publish(String(data=ZERO_AXIS))
+        assert probe.spin_until(
+            lambda: node.log().count('robot_description rejected') == 2, 10.0)
+        kept = status()
+        assert kept.level == kept.WARN
+        assert REASON in kept.message and \
+            'the previous model keeps working' in kept.message, kept.message
+        assert service().success
+    finally:
+        code = node.stop()
+        probe.close()
+    assert code == 0, node.log()
 
 
 # ---------------------------------------------------------------------------
