@@ -27,11 +27,12 @@
     newton-euler send TRAJECTORY.json | record BAG   (on a live ROS graph)
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
-(``.urdf``, with ``--base LINK --tip LINK`` to choose the chain).  Every
-error is one line on stderr.  Exit status: 0 done; 1 an input is unusable
-(a robot, scene, states or trajectory file, or a value in it); 2 the
-command line is wrong (unknown command or option, missing or malformed
-argument); 130 interrupted.
+(``.urdf``, or XML under any name, with ``--base LINK --tip LINK`` to
+choose the chain).  Every error is one line on stderr.  Exit status, the
+same for every command (docs/cli.md): 0 done; 1 the inputs were usable
+but the work failed (the ROS graph did not answer: no subscriber or
+publisher in time, nothing recorded; an internal error); 2 an input is
+wrong (the command line, or a file or value it names); 130 interrupted.
 """
 import argparse
 import json
@@ -42,14 +43,18 @@ import numpy as np
 from .cli_identify import register as register_identify
 from .cli_loop import register as register_loop
 from .cli_observe import register as register_observe
-from .cli_ros import register as register_ros, RosCliError
+from .cli_ros import register as register_ros, RosCliError, RosGraphError
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
                    RobotFileError)
 from .core.robot_file import bundled_robots, Note, read_text, to_number
 
-EXIT_USAGE = 2
-EXIT_ERROR = 1
+# the exit statuses of every command (docs/cli.md states the rule)
+EXIT_DONE = 0
+EXIT_FAILED = 1         # usable inputs, but the work failed
+EXIT_BAD_INPUT = 2      # the command line, or a file or value it names
+EXIT_USAGE = EXIT_BAD_INPUT
+EXIT_INTERRUPTED = 130
 MAX_JSON_BYTES = 64 * 1024 * 1024
 
 
@@ -58,7 +63,7 @@ class CliError(Exception):
 
 
 class InputError(NewtonEulerError):
-    """An input file or value is unusable (exit status 1)."""
+    """An input file or value is unusable (exit status 2)."""
 
 
 def _read_json(path):
@@ -435,14 +440,14 @@ def main(argv=None):
             parser.print_help()
             return EXIT_USAGE
         return args.func(args)
-    except (CliError, RosCliError) as exc:
+    except RosGraphError as exc:
         print(f'newton-euler: error: {exc}', file=sys.stderr)
-        return EXIT_USAGE
-    except NewtonEulerError as exc:
+        return EXIT_FAILED
+    except (CliError, RosCliError, NewtonEulerError) as exc:
         print(f'newton-euler: error: {exc}', file=sys.stderr)
-        return EXIT_ERROR
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
 
 
 if __name__ == '__main__':

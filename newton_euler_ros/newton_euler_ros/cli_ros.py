@@ -54,7 +54,11 @@ JOINT_STATE = 'sensor_msgs/msg/JointState'
 
 
 class RosCliError(Exception):
-    """A bad input or a graph that cannot serve: one line, exit status 2."""
+    """A bad input: one line, exit status 2."""
+
+
+class RosGraphError(RosCliError):
+    """The ROS graph did not answer in time: one line, exit status 1."""
 
 
 def register(subparsers):
@@ -238,9 +242,10 @@ def cmd_send(args):
                               args.wait):
             if ros.stop:
                 return 130
-            raise RosCliError(f'no subscriber on {args.topic} after '
-                              f'{args.wait:g} s (is the node or the '
-                              f'controller running, in this ROS_DOMAIN_ID?)')
+            raise RosGraphError(f'no subscriber on {args.topic} after '
+                                f'{args.wait:g} s (is the node or the '
+                                f'controller running, in this '
+                                f'ROS_DOMAIN_ID?)')
         now = ros.node.get_clock().now().nanoseconds
         start = now + int(args.start_in * 1e9) if args.start_in > 0 else 0
         pub.publish(trajectory_message(names, points, start))
@@ -336,9 +341,9 @@ def cmd_record(args):
                               args.wait):
             if ros.stop:
                 return 130
-            raise RosCliError(f'no publisher on {topic} after '
-                              f'{args.wait:g} s (is the robot driver '
-                              f'running, in this ROS_DOMAIN_ID?)')
+            raise RosGraphError(f'no publisher on {topic} after '
+                                f'{args.wait:g} s (is the robot driver '
+                                f'running, in this ROS_DOMAIN_ID?)')
         types, best_effort = _publishers(ros, topic)
         if types != {JOINT_STATE}:
             raise RosCliError(f'{topic} carries {", ".join(sorted(types))}, '
