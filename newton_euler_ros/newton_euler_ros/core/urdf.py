@@ -126,19 +126,34 @@ def _parse(text, src):
         line, col = getattr(exc, 'position', (0, 0))
         raise RobotFileError(f'{src.label}: not well-formed XML (line '
                              f'{line}, column {col + 1})') from None
+    sign = _xacro_sign(root)
+    if sign:
+        raise RobotFileError(f'{src.label}: xacro, not URDF ({sign}): '
+                             f'expand it with xacro first')
     if root.tag != 'robot':
-        if root.tag.startswith('{') and 'xacro' in root.tag:
-            raise RobotFileError(f'{src.label}: a xacro file: expand it '
-                                 f'with xacro first')
         raise RobotFileError(f'{src.label}: the root element is '
                              f'<{_short(root.tag)}>, not <robot>')
-    for el in root.iter():
-        if isinstance(el.tag, str) and el.tag.startswith('{') \
-                and 'xacro' in el.tag:
-            raise RobotFileError(
-                f'{src.label}: contains xacro elements '
-                f'(<{_short(el.tag)}>): expand it with xacro first')
     return root
+
+
+def _xacro_sign(root):
+    """
+    Return what shows a document is xacro, or '' for plain XML.
+
+    An element in the xacro namespace (``<xacro:macro>``), or an
+    attribute holding a xacro expression (``${...}``) or substitution
+    (``$(find ...)``).  The ``xmlns:xacro`` declaration alone is not a
+    sign: xacro leaves it in the URDF it writes.
+    """
+    for el in root.iter():
+        tag = el.tag if isinstance(el.tag, str) else ''
+        if tag.startswith('{') and 'xacro' in tag.partition('}')[0]:
+            return f'<xacro:{_short(tag.partition("}")[2], 60)}>'
+        for attr, value in el.attrib.items():
+            if '${' in value or '$(' in value:
+                return (f'<{_short(tag, 60)} {_short(attr, 60)}='
+                        f'"{_short(value, 60)}">')
+    return ''
 
 
 def _numbers(el, attr, count, where, src, default=None):

@@ -487,7 +487,15 @@ BAD = [
      r'refused'),
     ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
      '<xacro:property name="a" value="1"/><link name="b"/></robot>',
-     r'xacro elements .*: expand it with xacro first'),
+     r'xacro, not URDF \(<xacro:property>\): expand it with xacro first$'),
+    ('<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro"><link '
+     'name="b"/><link name="a"/><joint name="j" type="fixed"><parent '
+     'link="b"/><child link="a"/><origin xyz="0 0 ${h}"/></joint></robot>',
+     r'xacro, not URDF \(<origin xyz="0 0 \$\{h\}">\): expand it with '
+     r'xacro first$'),
+    ('<robot name="r"><link name="b"><visual><geometry><mesh filename='
+     '"$(find arm)/base.stl"/></geometry></visual></link></robot>',
+     r'xacro, not URDF \(<mesh filename="\$\(find arm\)/base.stl">\)'),
 ]
 
 
@@ -497,6 +505,29 @@ def test_bad_urdf_is_one_clear_error(text, message):
         load_urdf(text, tip='a')
     assert '\n' not in str(info.value)
     assert str(info.value).startswith('robot_description: ')
+
+
+def test_xacro_namespace_alone_is_not_xacro():
+    """Load a URDF with xmlns:xacro: xacro leaves it in what it writes."""
+    text = ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            + one_link()[len('<robot name="r">'):])
+    assert load_urdf(text, tip='a').n == 1
+
+
+def test_urdf_and_xacro_are_recognised_by_content(tmp_path):
+    """A URDF under another name loads; a xacro file is one line."""
+    xml = tmp_path / 'arm.xml'
+    xml.write_text('\ufeff\n  ' + one_link())
+    assert load_robot(str(xml), tip='a').n == 1
+    xacro = tmp_path / 'arm.urdf.xacro'
+    xacro.write_text('<?xml version="1.0"?>\n<robot name="r" xmlns:xacro='
+                     '"http://www.ros.org/wiki/xacro"><xacro:include '
+                     'filename="arm.xacro"/></robot>')
+    with pytest.raises(RobotFileError) as info:
+        load_robot(str(xacro))
+    assert str(info.value) == ('arm.urdf.xacro: xacro, not URDF '
+                               '(<xacro:include>): expand it with xacro '
+                               'first')
 
 
 def test_chain_errors_name_the_links():
