@@ -361,12 +361,14 @@ class _Parser(argparse.ArgumentParser):
         raise CliError(message)
 
 
+ROBOT_HELP = 'robot YAML or URDF file, or bundled robot name'
+
+
 def build_parser():
     parser = _Parser(prog='newton-euler', description=__doc__.strip().split('\n')[0])
     sub = parser.add_subparsers(dest='command', parser_class=_Parser)
     dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
-    dyn.add_argument('robot', help='robot YAML or URDF file, or bundled '
-                                   'robot name')
+    dyn.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     _chain_options(dyn)
     dyn.add_argument('--q', nargs='+', metavar='Q',
                      help='joint positions (rad or m)')
@@ -388,18 +390,19 @@ def build_parser():
                           ' and print a JSON list')
     dyn.set_defaults(func=cmd_dynamics)
     chk = sub.add_parser('check', help='validate a robot file')
-    chk.add_argument('robot')
+    chk.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     _chain_options(chk)
     chk.set_defaults(func=cmd_check)
     urdf = sub.add_parser('urdf', help='write a robot as URDF (inertials, '
                                        'limits, a fixed tool0 link)')
-    urdf.add_argument('robot')
+    urdf.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     urdf.add_argument('-o', '--output', metavar='FILE',
                       help='write to FILE instead of standard output')
     _chain_options(urdf)
     urdf.set_defaults(func=cmd_urdf)
     sim = sub.add_parser('simulate', help='simulate a scene offline')
-    sim.add_argument('scene', help='scene YAML file or bundled scene name')
+    sim.add_argument('scene', metavar='SCENE',
+                     help='scene YAML file or bundled scene name')
     sim.add_argument('--duration', type=float, metavar='T',
                      help="simulated seconds (default: the scene's)")
     sim.add_argument('--json', action='store_true',
@@ -410,10 +413,11 @@ def build_parser():
     sim.set_defaults(func=cmd_simulate)
     ff = sub.add_parser('feedforward', help='fill the effort of every point '
                                             'of a joint trajectory')
-    ff.add_argument('robot')
-    ff.add_argument('trajectory', help='JSON: {"joint_names": [...], '
-                                       '"points": [{"time_from_start": t, '
-                                       '"positions": [...], ...}]}')
+    ff.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    ff.add_argument('trajectory', metavar='TRAJECTORY.json',
+                    help='JSON: {"joint_names": [...], "points": '
+                         '[{"time_from_start": t, "positions": [...], '
+                         '...}]}')
     ff.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
                                                   'NY', 'NZ'),
                     help='wrench the end effector exerts along the whole '

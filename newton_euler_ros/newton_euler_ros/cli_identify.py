@@ -61,8 +61,10 @@ def register(subparsers):
     rep = subparsers.add_parser(
         'replay', help="the model's torques along a recording, against the "
                        'measured efforts (CSV, plot)')
-    rep.add_argument('model', metavar='MODEL.urdf')
-    rep.add_argument('bag', metavar='BAG')
+    rep.add_argument('model', metavar='MODEL.urdf',
+                     help='the URDF whose torques are replayed')
+    rep.add_argument('bag', metavar='BAG', help='rosbag2 directory (MCAP or '
+                                                'sqlite3)')
     _common(rep)
     rep.add_argument('--csv', metavar='OUT.csv', required=True,
                      help='one row per JointState message: time, then '

@@ -66,7 +66,8 @@ def register(subparsers):
     snd = subparsers.add_parser(
         'send', help='publish a JointTrajectory JSON file once (to the '
                      "node's ~/trajectory_in or a controller)")
-    snd.add_argument('trajectory', help='JointTrajectory JSON file')
+    snd.add_argument('trajectory', metavar='TRAJECTORY.json',
+                     help='JointTrajectory JSON file')
     snd.add_argument('--topic', default='/inverse_dynamics_node/'
                      'trajectory_in', help='where to publish (default: '
                      '%(default)s)')
@@ -83,8 +84,8 @@ def register(subparsers):
     snd.set_defaults(func=cmd_send)
     rec = subparsers.add_parser(
         'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
-    rec.add_argument('bag', help='rosbag2 directory to create (must not '
-                                 'exist)')
+    rec.add_argument('bag', metavar='BAG',
+                     help='rosbag2 directory to create (must not exist)')
     rec.add_argument('--topic', default='/joint_states',
                      help='JointState topic (default: %(default)s)')
     rec.add_argument('--duration', type=float, metavar='S',

@@ -39,6 +39,10 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 NODES = ('inverse_dynamics_node', 'robot_sim_node', 'tracking_controller_node')
+#: each node's reference page (topics, parameters), in the repository
+NODE_PAGES = {'inverse_dynamics_node': 'docs/node.md',
+              'robot_sim_node': 'docs/scenes-and-demos.md',
+              'tracking_controller_node': 'docs/scenes-and-demos.md'}
 
 
 def schema_path(node_name):
@@ -199,6 +203,8 @@ def node_help(node_name):
         doc = ast.get_docstring(ast.parse(fh.read())) or node_name
     lines = [f'usage: {node_name} [-h] [--ros-args [-p NAME:=VALUE]... '
              f'[--params-file FILE]... [-r FROM:=TO]...]', '', doc, '',
+             f'Reference: {NODE_PAGES[node_name]} in the newton_euler_ros '
+             f'repository.', '',
              *textwrap.wrap(
                  f'Parameters (-p NAME:=VALUE, or --params-file FILE with '
                  f'a section {node_name}: or /**:; an unknown name stops '

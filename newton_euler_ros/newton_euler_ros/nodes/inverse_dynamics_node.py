@@ -16,7 +16,7 @@
 inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
-result is published.  See the README ("ROS 2 node") for the interface.
+result is published.  docs/node.md describes the whole interface.
 
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
