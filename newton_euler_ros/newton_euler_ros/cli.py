@@ -264,6 +264,8 @@ def cmd_check(args):
               f'{", ".join(report["merged_fixed"]) or "none"}')
         print(f'  lumped off-chain subtrees (at zero position): '
               f'{", ".join(report["lumped"]) or "none"}')
+        print(f'  locked off-chain moving joints: '
+              f'{", ".join(report.get("locked", ())) or "none"}')
         print(f'  continuous joints: '
               f'{", ".join(report["continuous"]) or "none"}')
     print(f'  total mass: {model.total_mass:.6g} kg')
