@@ -123,12 +123,11 @@ class JointOrder:
             self._other_names = list(names)
             raise self._other_joints(names)
         if missing:
-            known = set(self.model_joints)
-            unknown = [clip(x, 60) for x in names if x not in known][:5]
+            # all of them, and what the message does name
             raise InputRejected(
-                'missing_joints', f'missing joints {missing}'
-                + (f'; not joints of the robot: {unknown}' if unknown
-                   else ''))
+                'missing_joints', f'missing joints {clip(missing, 600)}; '
+                f'the message names {len(names)}: '
+                f'{clip([clip(x, 60) for x in names], 600)}')
         take = np.array([where[j] for j in self.model_joints], dtype=np.intp)
         self._cache_names = list(names)
         self._cache_take = take
