@@ -21,8 +21,9 @@ URDF saved under another name (``ur5.xml``) is read as the URDF it is.
 
 Missing joints are all named, with the names the input has: in a bag
 (identify, replay, observe, payload) and in a JointState or a service
-request to the node.  replay says why its low-passed error can exceed
-the raw one.
+request to the node (also through examples/compute_dynamics_client.py,
+which takes the robot's joint names and state).  replay says why its
+low-passed error can exceed the raw one.
 """
 import os
 import shutil
@@ -39,6 +40,9 @@ from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: I100
                          NodeProcess, Probe, ros_env)
 
 DOMAIN = domain_id(67)
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(
+    os.path.abspath(__file__)))))
+PUMA = [f'joint{k}' for k in range(1, 7)]
 XACRO = """<?xml version="1.0"?>
 <robot name="arm" xmlns:xacro="http://www.ros.org/wiki/xacro">
   <xacro:arg name="prefix" default=""/>
@@ -200,6 +204,26 @@ def test_node_names_every_missing_joint(tmp_path):
                                                    position=[0.1] * 4))
         assert not reply.success and reply.message == expected, \
             reply.message
+        # the example client, with the robot's joints and state
+        client = [sys.executable, os.path.join(ROOT, 'examples',
+                                               'compute_dynamics_client.py')]
+        proc = subprocess.run(
+            client + ['--joints', *reversed(PUMA), '--q', *'0.3 0.2 0.1 '
+                      '-0.3 0.5 0'.split(), '--qd', *['0.1'] * 6],
+            capture_output=True, text=True, timeout=120, env=ros_env(DOMAIN))
+        assert proc.returncode == 0, proc.stderr
+        assert f'joints {PUMA}' in proc.stdout and 'tau = ' in proc.stdout
+        proc = subprocess.run(client + ['--joints', *names, '--q',
+                                        *['0.1'] * 4],
+                              capture_output=True, text=True, timeout=120,
+                              env=ros_env(DOMAIN))
+        assert proc.returncode == 1 and proc.stderr.strip() == \
+            f'/inverse_dynamics_node/compute_dynamics: {expected}', \
+            proc.stderr
+        proc = subprocess.run(client + ['--joints', 'a', 'b', '--q', '1'],
+                              capture_output=True, text=True, timeout=60)
+        assert proc.returncode == 2 and proc.stderr.strip().endswith(
+            'error: --q: 1 values for 2 joints'), proc.stderr
     finally:
         code = node.stop()
         probe.close()
