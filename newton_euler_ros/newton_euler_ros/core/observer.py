@@ -39,9 +39,11 @@ joint j is in contact when ``|r_j|`` exceeds its threshold plus an
 *allowance*: the bound ``B_j = F_s,j (1 - |tanh(qd_j / eps_j)|)`` on
 that unmodelled friction, passed through the residual's own lag
 (``A_k = a A_(k-1) + (1 - a) max(B_(k-1), B_k)``), so that it bounds
-its share of r through stops and starts too.  The cost: at rest a joint
-feels only what exceeds its static friction band.  :func:`drive_options`
-takes F_s as a multiple (1 by default) of the Coulomb friction.
+its share of r through stops and starts too; falling, no faster than
+over ``ALLOWANCE_HOLD`` (friction settles over some travel after a
+start, not at once).  The cost: at rest a joint feels only what exceeds
+its static friction band.  :func:`drive_options`
+takes F_s as a multiple (1.5 by default) of the Coulomb friction.
 
 Discretization.  Between two samples the running sum
 ``S = p(0) + integral (tau + C^T qd - g + r) ds`` advances with the
@@ -82,6 +84,8 @@ from .drives import DEFAULT_COULOMB_WIDTH
 from .errors import DynamicsInputError
 from .kernels import NONFINITE, run_momentum_terms, SIZE
 from .kernels._jit import ENTRY, uses_kernels
+from .observer_thresholds import (beyond_friction,  # noqa: F401
+                                  suggest_thresholds)
 from .observer_wrench import external_wrench, felt_directions  # noqa: F401
 from .workspace import Workspace
 
@@ -89,6 +93,9 @@ from .workspace import Workspace
 # recompile them (numba's cache stamps a function with its own file only)
 uses_kernels(__file__)
 
+#: s: the static friction allowance decays no faster than this (a
+#: joint's friction settles to the moving friction over some travel)
+ALLOWANCE_HOLD = 0.1
 #: what :func:`observer_step` did with a sample
 UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \
     'restarted', 'duplicate'
@@ -155,8 +162,12 @@ def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev, fric):
             S[i] += known + r[i] * b / k + u * (dt - b / k)
             r[i] = a * r[i] + b * u
             ok &= math.isfinite(r[i]) and math.isfinite(S[i])
-            # the same lag on the interval's larger bound
-            fric[0, i] = a * fric[0, i] + b * max(bound, fric[1, i])
+            # the same lag on the interval's larger bound; falling, no
+            # faster than ALLOWANCE_HOLD (friction lags a start)
+            target = max(bound, fric[1, i])
+            if target < fric[0, i] and k * ALLOWANCE_HOLD > 1.0:
+                a = math.exp(-dt / ALLOWANCE_HOLD)
+            fric[0, i] = a * fric[0, i] + (1.0 - a) * target
         fric[1, i] = bound
     for i in range(n):
         if not ok or not math.isfinite(r[i]):
@@ -338,7 +349,7 @@ def drive_terms(model):
     return drive_torque, armature
 
 
-def drive_options(model, static_friction=1.0):
+def drive_options(model, static_friction=1.5):
     """
     Return :class:`MomentumObserver` keyword arguments from a model's drives.
 
@@ -346,8 +357,9 @@ def drive_options(model, static_friction=1.0):
     ``torque_constant`` (None unless the URDF gives it: the efforts are
     then torques), and the static friction allowance: ``static_friction``
     times each joint's Coulomb friction (URDF ``<dynamics friction>``, as
-    identify writes it), fading over its tanh width.  ``static_friction``
-    0 leaves the allowance out.
+    identify writes it), fading over its tanh width.  The default 1.5:
+    static friction is commonly 20-50 % above the Coulomb level, which an
+    identification gives within some 10 %.  0 leaves the allowance out.
     """
     ratio = float(static_friction)
     if not (math.isfinite(ratio) and ratio >= 0.0):
@@ -569,29 +581,3 @@ def observe_recording(obs, T, Q, QD, TAU):
     out.restarts = state.restarts
     return out
 
-
-def beyond_friction(recording):
-    """Return (m, n): how far each |residual| lies beyond the allowance."""
-    return np.maximum(np.abs(recording.residual) - recording.allowance, 0.0)
-
-
-def suggest_thresholds(recording, factor=1.5):
-    """
-    Return per-joint thresholds (n,) from a free-motion recording.
-
-    ``factor`` times the largest ``|r|`` beyond the static friction
-    allowance (:func:`beyond_friction`), rounded up to two digits (0.1 at
-    least): what the contact test compares with the threshold, so a like
-    recording stays below them by that factor.  Stops are allowed for,
-    whatever their length; a contact during the recording would be taken
-    for noise.
-    """
-    peak = beyond_friction(recording).max(axis=0, initial=0.0)
-    return np.array([_round_up(factor * x) for x in peak])
-
-
-def _round_up(x):
-    if not x > 0.0:
-        return 0.1
-    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
-    return max(0.1, math.ceil(x / scale - 1e-9) * scale)
