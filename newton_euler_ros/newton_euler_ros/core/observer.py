@@ -580,4 +580,3 @@ def observe_recording(obs, T, Q, QD, TAU):
     out.contacts = contact.count
     out.restarts = state.restarts
     return out
-
