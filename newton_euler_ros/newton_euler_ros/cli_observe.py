@@ -279,7 +279,7 @@ def _table(s):
             f'{s["peak_beyond_friction"][j]:>9.3g}{s["rms"][j]:>9.3g}'
             f'{s["suggested_thresholds"][j]:>10.3g}')
     lines.append('friction = static friction allowed for at rest (N m or '
-                 'N); beyond = max |tau_ext| beyond it; suggested = 1.5 x '
+                 'N); beyond = max |tau_ext| beyond it; suggested = 2 x '
                  'beyond (valid when the recording is free motion, no '
                  'contact)')
     for note in s['notes']:

@@ -25,13 +25,18 @@ import math
 
 import numpy as np
 
+#: suggested threshold = this x the free-motion peak beyond the allowance:
+#: the peaks of other recordings of like motion reached up to 1.6 x that
+#: of the one suggesting (model error depends on the motion)
+FACTOR = 2.0
+
 
 def beyond_friction(recording):
     """Return (m, n): how far each |residual| lies beyond the allowance."""
     return np.maximum(np.abs(recording.residual) - recording.allowance, 0.0)
 
 
-def suggest_thresholds(recording, factor=1.5):
+def suggest_thresholds(recording, factor=FACTOR):
     """
     Return per-joint thresholds (n,) from a free-motion recording.
 

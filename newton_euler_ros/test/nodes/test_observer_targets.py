@@ -44,6 +44,7 @@ import warnings
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.observer import (drive_options, MomentumObserver,
                                             observe_recording)
+from newton_euler_ros.core.observer_thresholds import FACTOR
 from newton_euler_ros.ident.bag import read_joint_states
 import numpy as np
 import pytest
@@ -155,10 +156,11 @@ def test_pushes_reported_and_no_contact_at_rest(recordings, thresholds):
     at_rest = out.contact[resting & ~pushed].mean()
     assert at_rest <= 0.10, at_rest
     # every push reported, within 0.2 s of exceeding the band: the
-    # threshold, plus the model error free motion showed (up to 1/1.5 of
-    # it, of either sign), the allowance, and what a resting joint holds
+    # threshold, plus the model error free motion showed (up to 1/FACTOR
+    # of it, of either sign), the allowance, and what a resting joint holds
     held = np.where(truth['qd'][i] == 0.0, static, 0.0)
-    band = (1.0 + 1.0 / 1.5) * np.asarray(thresholds) + out.allowance + held
+    band = (1.0 + 1.0 / FACTOR) * np.asarray(thresholds) + out.allowance \
+        + held
     beyond = (np.abs(external) > band).any(axis=1)
     rows = []
     for p in recordings['pushes']:
