@@ -15,21 +15,27 @@
 """
 ``newton-euler observe``: the momentum observer over a recorded bag.
 
-    newton-euler observe MODEL.urdf BAG --base LINK --tip LINK --csv OUT.csv
-                         [--plot OUT.png] [--topic T] [--gain K]
-                         [--thresholds T [T ...]] [--hysteresis H]
+    newton-euler observe MODEL.urdf BAG --base LINK --tip LINK
+                         [--csv OUT.csv] [--plot OUT.png] [--json]
+                         [--topic T] [--gain K] [--thresholds T [T ...]]
+                         [--static-friction R] [--hysteresis H]
                          [--damping L] [--max-gap S]
                          [--payload-mass M] [--payload-com X Y Z]
 
 The same observer as inverse_dynamics_node's ``observer.*`` parameters
 (:mod:`newton_euler_ros.core.observer`), run over the JointStates of a
 rosbag2 recording (MCAP or sqlite3), so that gain and thresholds can be
-tuned on one's own recording before turning it on.  Writes one CSV row
-per sample (time, external torque per joint, external wrench, contact)
-and, with ``--plot``, a PNG; both are written atomically.  Prints a
-summary with each joint's largest |external torque|, from which to set
-the thresholds when the recording is free motion (docs/observer.md).
+tuned on one's own recording before turning it on.  Efforts are
+converted to joint torques through the URDF's torque constants when it
+has them (``<ne:drive torque_constant>``: a current-sensing arm).  With
+``--csv``, writes one row per sample (time, external torque per joint,
+external wrench, contact) and, with ``--plot``, a PNG; both are written
+atomically.  Prints a summary with each joint's largest |external
+torque| beyond the static friction allowance, and the thresholds it
+suggests when the recording is free motion (docs/observer.md); with
+``--json``, the same as one JSON object on stdout instead.
 """
+import json
 import math
 import os
 import sys
@@ -49,18 +55,23 @@ def register(subparsers):
     obs = subparsers.add_parser(
         'observe', help='run the momentum observer (external torque, '
                         'wrench, contact) over a recorded bag')
-    obs.add_argument('robot', help='URDF (or robot YAML) file, or bundled '
-                                   'robot name')
-    obs.add_argument('bag', help='rosbag2 directory (MCAP or sqlite3) with '
-                                 'sensor_msgs/JointState')
+    obs.add_argument('robot', metavar='ROBOT',
+                     help='URDF (or robot YAML) file, or bundled robot name')
+    obs.add_argument('bag', metavar='BAG',
+                     help='rosbag2 directory (MCAP or sqlite3) with '
+                          'sensor_msgs/JointState')
     obs.add_argument('--base', metavar='LINK',
                      help='URDF only: first link of the chain (default: '
                           'the root link)')
     obs.add_argument('--tip', metavar='LINK',
                      help='URDF only: last link, the end effector '
                           '(default: the single leaf)')
-    obs.add_argument('--csv', metavar='OUT.csv', required=True,
+    obs.add_argument('--csv', metavar='OUT.csv',
                      help='write one row per sample here')
+    obs.add_argument('--json', action='store_true',
+                     help='print the summary as one JSON object (with '
+                          'suggested_thresholds, one per joint in chain '
+                          'order) instead of a table')
     obs.add_argument('--plot', metavar='OUT.png',
                      help='also plot external torques and wrench')
     obs.add_argument('--topic', default='/joint_states',
@@ -69,7 +80,13 @@ def register(subparsers):
                      help='observer gain, 1/s (default 50)')
     obs.add_argument('--thresholds', type=float, nargs='+', default=[10.0],
                      metavar='T', help='contact threshold per joint in '
-                     'chain order, or one for all (N m or N; default 10)')
+                     'chain order, or one for all (N m or N, also for a '
+                     'current-sensing arm; default 10)')
+    obs.add_argument('--static-friction', type=float, default=1.5,
+                     metavar='R', help='at rest, allow for static friction '
+                     "up to R x each joint's Coulomb friction (URDF "
+                     '<dynamics friction>) above the thresholds; 0: none '
+                     '(default 1.5)')
     obs.add_argument('--hysteresis', type=float, default=0.5,
                      help='release below this fraction of the threshold '
                           '(default 0.5)')
@@ -114,12 +131,13 @@ def _finite(name, value, low=None, strict=True):
 def _setup(args):
     """Model (payload included) and observer; _Usage on bad input."""
     from .core import inspect_robot, NewtonEulerError
-    from .core.observer import drive_terms, MomentumObserver
+    from .core.observer import drive_options, MomentumObserver
     from .feedforward import payload_model
 
     for name in ('gain', 'max_gap'):
         _finite(f'--{name.replace("_", "-")}', getattr(args, name), 0.0)
     _finite('--damping', args.damping, 0.0, strict=False)
+    _finite('--static-friction', args.static_friction, 0.0, strict=False)
     _finite('--hysteresis', args.hysteresis, 0.0)
     for opt, path in (('--csv', args.csv), ('--plot', args.plot)):
         if path and os.path.isdir(path):
@@ -138,12 +156,11 @@ def _setup(args):
             raise ValueError(
                 f'--thresholds: give 1 or {model.n} values (chain order '
                 f'{list(model.joint_names)}), got {len(args.thresholds)}')
-        drive, armature = drive_terms(model)
         obs = MomentumObserver(model, args.gain, max_gap=args.max_gap,
-                               drive_torque=drive, armature=armature,
                                damping=args.damping,
                                thresholds=args.thresholds,
-                               hysteresis=args.hysteresis)
+                               hysteresis=args.hysteresis,
+                               **drive_options(model, args.static_friction))
     except ValueError as exc:
         raise _Usage(str(exc).replace('payload.', '--payload-')) from None
     return model, obs
@@ -174,12 +191,18 @@ def _observe(args):
                      f'joint velocities)')
     out = observe_recording(obs, rec.stamps, rec.q, rec.qd, rec.effort)
     names = list(model.joint_names)
-    _atomic_write(args.csv, lambda fh: _write_csv(fh, rec, out, names))
-    lines = _summary(args, model, rec, out)
+    if args.csv:
+        _atomic_write(args.csv, lambda fh: _write_csv(fh, rec, out, names))
     if args.plot:
         _plot(args.plot, rec.stamps, names, out, obs.thresholds)
-    print('\n'.join(lines))
-    print(f'wrote {args.csv}' + (f' and {args.plot}' if args.plot else ''))
+    summary = _summary(args, model, obs, rec, out)
+    if args.json:
+        print(json.dumps(summary))
+        return 0
+    print('\n'.join(_table(summary)))
+    wrote = [x for x in (args.csv, args.plot) if x]
+    if wrote:
+        print('wrote ' + ' and '.join(wrote))
     return 0
 
 
@@ -194,36 +217,75 @@ def _write_csv(fh, rec, out, names):
         fh.write(','.join(row) + '\n')
 
 
-def _summary(args, model, rec, out):
+def _intervals(t, flag):
+    """[[start, end], ...] (s) of the runs where ``flag`` is true."""
+    edges = np.flatnonzero(np.diff(np.concatenate(([0], flag.astype(int),
+                                                   [0]))))
+    return [[float(t[a]), float(t[min(b, len(t) - 1)])]
+            for a, b in zip(edges[::2], edges[1::2])]
+
+
+def _summary(args, model, obs, rec, out):
+    """Return what the command found, as a dict (the --json object)."""
+    from .core.observer import beyond_friction, suggest_thresholds
     t = out.t
-    peak = np.abs(out.residual).max(axis=0)
-    rms = np.sqrt((out.residual ** 2).mean(axis=0))
-    thresholds = np.resize(np.asarray(args.thresholds, float), model.n)
+    resting = (np.abs(rec.qd) < obs.friction_width).all(axis=1)
+    constant = obs.torque_constant
+    return {
+        'robot': model.name, 'bag': args.bag, 'topic': args.topic,
+        'joints': list(model.joint_names), 'samples': int(len(t)),
+        'first_stamp_ns': int(rec.stamps_ns[0]),
+        'duration': float(t[-1] - t[0]), 'gain': args.gain,
+        'restarts': int(out.restarts), 'skipped': int(out.skipped),
+        'torque_constant': None if constant is None else constant.tolist(),
+        'static_friction': args.static_friction,
+        'friction_allowance': obs.static_friction.tolist(),
+        'thresholds': obs.thresholds.tolist(),
+        'peak': np.abs(out.residual).max(axis=0).tolist(),
+        'rms': np.sqrt((out.residual ** 2).mean(axis=0)).tolist(),
+        'peak_beyond_friction': beyond_friction(out).max(axis=0).tolist(),
+        'suggested_thresholds': suggest_thresholds(out).tolist(),
+        'contacts': int(out.contacts),
+        'contact_fraction': float(out.contact.mean()),
+        'resting_fraction': float(resting.mean()),
+        'contact_fraction_at_rest': (float(out.contact[resting].mean())
+                                     if resting.any() else None),
+        'contact_intervals': _intervals(t, out.contact),
+        'csv': args.csv, 'plot': args.plot,
+        'notes': list(getattr(rec, 'notes', []))}
+
+
+def _table(s):
+    """Return the summary as the lines the command prints."""
+    at_rest = s['contact_fraction_at_rest']
     lines = [
-        f'{model.name}: {len(t)} samples over {t[-1] - t[0]:.3f} s from '
-        f'{args.bag} ({args.topic}); gain {args.gain:g} 1/s, '
-        f'{out.restarts} restart(s), {out.skipped} sample(s) skipped',
-        f'contacts: {out.contacts} (in contact {out.contact.mean():.1%} of '
-        f'samples)',
-        f'{"joint":<24}{"threshold":>11}{"max |tau_ext|":>15}'
-        f'{"rms":>10}{"suggested":>11}']
-    for j, name in enumerate(model.joint_names):
-        lines.append(f'{name:<24}{thresholds[j]:>11.3g}{peak[j]:>15.3g}'
-                     f'{rms[j]:>10.3g}{_suggest(peak[j]):>11.3g}')
-    lines.append('suggested = 1.5 x max |tau_ext| (valid when the recording '
-                 'is free motion, no contact)')
-    for note in getattr(rec, 'notes', []):
+        f'{s["robot"]}: {s["samples"]} samples over {s["duration"]:.3f} s '
+        f'from {s["bag"]} ({s["topic"]}); gain {s["gain"]:g} 1/s, '
+        f'{s["restarts"]} restart(s), {s["skipped"]} sample(s) skipped',
+        f'contacts: {s["contacts"]} (in contact {s["contact_fraction"]:.1%} '
+        f'of samples' + ('' if at_rest is None else
+                         f', {at_rest:.1%} of those at rest') + ')']
+    if s['torque_constant'] is not None:
+        lines.append("efforts converted to joint torques with the URDF's "
+                     'torque constants ' + ', '.join(
+                         f'{k:.4g}' for k in s['torque_constant'])
+                     + ' (N m per effort unit)')
+    lines.append(f'{"joint":<24}{"threshold":>10}{"friction":>10}'
+                 f'{"max |tau_ext|":>14}{"beyond":>9}{"rms":>9}'
+                 f'{"suggested":>10}')
+    for j, name in enumerate(s['joints']):
+        lines.append(
+            f'{name:<24}{s["thresholds"][j]:>10.3g}'
+            f'{s["friction_allowance"][j]:>10.3g}{s["peak"][j]:>14.3g}'
+            f'{s["peak_beyond_friction"][j]:>9.3g}{s["rms"][j]:>9.3g}'
+            f'{s["suggested_thresholds"][j]:>10.3g}')
+    lines.append('friction = static friction allowed for at rest (N m or '
+                 'N); beyond = max |tau_ext| beyond it; suggested = 2 x '
+                 'beyond (valid when the recording is free motion, no '
+                 'contact)')
+    for note in s['notes']:
         lines.append(f'note: {note}')
     return lines
-
-
-def _suggest(peak):
-    """Return a threshold above a free-motion peak: 1.5 x, 2 digits."""
-    x = 1.5 * peak
-    if x <= 0.0:
-        return 0.1
-    scale = 10.0 ** (math.floor(math.log10(x)) - 1)
-    return math.ceil(x / scale) * scale
 
 
 def _plot(path, t, names, out, thresholds):
@@ -235,8 +297,10 @@ def _plot(path, t, names, out, thresholds):
     ax = axes[0]
     for j, name in enumerate(names):
         line, = ax.plot(t, out.residual[:, j], lw=0.8, label=name)
-        ax.axhline(thresholds[j], color=line.get_color(), lw=0.5, ls=':')
-        ax.axhline(-thresholds[j], color=line.get_color(), lw=0.5, ls=':')
+        # the contact test's bound: threshold + static friction allowance
+        bound = thresholds[j] + out.allowance[:, j]
+        ax.plot(t, bound, color=line.get_color(), lw=0.5, ls=':')
+        ax.plot(t, -bound, color=line.get_color(), lw=0.5, ls=':')
     ax.set_ylabel('external torque\n(N m or N)')
     ax.legend(fontsize=7, ncol=4, loc='upper right')
     for ax, cols, unit in ((axes[1], slice(0, 3), 'force (N)'),

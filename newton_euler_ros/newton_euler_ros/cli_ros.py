@@ -54,7 +54,11 @@ JOINT_STATE = 'sensor_msgs/msg/JointState'
 
 
 class RosCliError(Exception):
-    """A bad input or a graph that cannot serve: one line, exit status 2."""
+    """A bad input: one line, exit status 2."""
+
+
+class RosGraphError(RosCliError):
+    """The ROS graph did not answer in time: one line, exit status 1."""
 
 
 def register(subparsers):
@@ -62,7 +66,8 @@ def register(subparsers):
     snd = subparsers.add_parser(
         'send', help='publish a JointTrajectory JSON file once (to the '
                      "node's ~/trajectory_in or a controller)")
-    snd.add_argument('trajectory', help='JointTrajectory JSON file')
+    snd.add_argument('trajectory', metavar='TRAJECTORY.json',
+                     help='JointTrajectory JSON file')
     snd.add_argument('--topic', default='/inverse_dynamics_node/'
                      'trajectory_in', help='where to publish (default: '
                      '%(default)s)')
@@ -79,8 +84,8 @@ def register(subparsers):
     snd.set_defaults(func=cmd_send)
     rec = subparsers.add_parser(
         'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
-    rec.add_argument('bag', help='rosbag2 directory to create (must not '
-                                 'exist)')
+    rec.add_argument('bag', metavar='BAG',
+                     help='rosbag2 directory to create (must not exist)')
     rec.add_argument('--topic', default='/joint_states',
                      help='JointState topic (default: %(default)s)')
     rec.add_argument('--duration', type=float, metavar='S',
@@ -238,9 +243,10 @@ def cmd_send(args):
                               args.wait):
             if ros.stop:
                 return 130
-            raise RosCliError(f'no subscriber on {args.topic} after '
-                              f'{args.wait:g} s (is the node or the '
-                              f'controller running, in this ROS_DOMAIN_ID?)')
+            raise RosGraphError(f'no subscriber on {args.topic} after '
+                                f'{args.wait:g} s (is the node or the '
+                                f'controller running, in this '
+                                f'ROS_DOMAIN_ID?)')
         now = ros.node.get_clock().now().nanoseconds
         start = now + int(args.start_in * 1e9) if args.start_in > 0 else 0
         pub.publish(trajectory_message(names, points, start))
@@ -336,9 +342,9 @@ def cmd_record(args):
                               args.wait):
             if ros.stop:
                 return 130
-            raise RosCliError(f'no publisher on {topic} after '
-                              f'{args.wait:g} s (is the robot driver '
-                              f'running, in this ROS_DOMAIN_ID?)')
+            raise RosGraphError(f'no publisher on {topic} after '
+                                f'{args.wait:g} s (is the robot driver '
+                                f'running, in this ROS_DOMAIN_ID?)')
         types, best_effort = _publishers(ros, topic)
         if types != {JOINT_STATE}:
             raise RosCliError(f'{topic} carries {", ".join(sorted(types))}, '

@@ -35,6 +35,7 @@ import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core import observer as momentum
+from newton_euler_ros.core import observer_wrench
 from newton_euler_ros.core.dynamics import (coriolis_matrix, gravity_torques,
                                             jacobian, mass_matrix)
 from newton_euler_ros.core.kernels import (F_TOOL, run_jacobian,
@@ -91,7 +92,7 @@ def _separate_arithmetic(D, C, g, qd, tau, lost, armature, gain, dt, restart,
 # the solve and the contact as they were compiled then (with numba's
 # reference-counting runtime; uncached: numba's cache does not tell two
 # compilations of one function with other options apart)
-_dls_then = njit(momentum._dls_wrench.py_func)
+_dls_then = njit(observer_wrench._dls_wrench.py_func)
 _contact_then = njit(momentum._contact.py_func)
 
 
@@ -143,7 +144,7 @@ class SeparatePasses:
         """``contact_step`` as it was."""
         obs = self.obs
         now = _contact_then(r, obs.thresholds, obs.hysteresis,
-                            contact.active)
+                            obs._no_allowance, contact.active)
         if now and not contact.in_contact:
             contact.count += 1
         contact.in_contact = bool(now)

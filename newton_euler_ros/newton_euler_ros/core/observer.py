@@ -24,10 +24,26 @@ equation of motion ``D qdd + C qd + g = tau + tau_ext`` gives
 obeys ``rdot = K (tau_ext - r)``: a first-order low-pass of the external
 joint torque with gain ``K`` (1/s), needing no acceleration and no
 differentiation (De Luca and Mattone, ICRA 2005; Haddadin, De Luca and
-Albu-Schaeffer, T-RO 2017).  ``tau`` is what the drives apply (the
-JointState effort); what the model knows is not external is taken out
-first: the drive friction (``drive_torque``) and the rotor inertia
-(``armature``, added to the momentum); the payload is part of the model.
+Albu-Schaeffer, T-RO 2017).  ``tau`` is what the drives apply: the
+JointState effort, times the drives' torque constants when the effort is
+a motor current (``torque_constant``, N m per effort unit), so that
+everything here is in N m (or N).  What the model knows is not external
+is taken out first: the drive friction (``drive_torque``) and the rotor
+inertia (``armature``, added to the momentum); the payload is part of the
+model.
+
+Static friction at rest.  At rest, static friction holds any torque up to
+its static level F_s, depending on how the joint came to rest: no model
+knows it, and the drive friction ``F_c tanh(qd / eps)`` is 0 there.  So
+joint j is in contact when ``|r_j|`` exceeds its threshold plus an
+*allowance*: the bound ``B_j = F_s,j (1 - |tanh(qd_j / eps_j)|)`` on
+that unmodelled friction, passed through the residual's own lag
+(``A_k = a A_(k-1) + (1 - a) max(B_(k-1), B_k)``), so that it bounds
+its share of r through stops and starts too; falling, no faster than
+over ``ALLOWANCE_HOLD`` (friction settles over some travel after a
+start, not at once).  The cost: at rest a joint feels only what exceeds
+its static friction band.  :func:`drive_options`
+takes F_s as a multiple (1.5 by default) of the Coulomb friction.
 
 Discretization.  Between two samples the running sum
 ``S = p(0) + integral (tau + C^T qd - g + r) ds`` advances with the
@@ -46,21 +62,15 @@ messages stays reported; a stale residual decays at the rate ``K``).
 
 Functions, one per step: :func:`initial_state`, :func:`observer_step`,
 :func:`external_wrench`, :func:`contact_step`, and
-:func:`observe_recording` over a whole recording; :func:`drive_terms`
-takes the drive friction and rotor inertia from a model that has them.
+:func:`observe_recording` over a whole recording, then
+:func:`suggest_thresholds` from a free-motion recording;
+:func:`drive_options` takes the drive friction, rotor inertia, torque
+constants and static friction from a model that has them.
 
 Signs and frames.  The residual is the joint torque the environment
-applies, ``tau_ext = J^T F_ext``.  :func:`external_wrench` returns
-``F_ext = [f; m]``, the wrench the environment applies *to* the end
-effector (a wrist force/torque sensor's sign), in base-frame axes, the
-moment about the end-effector origin.  It is the opposite of the
-dynamics' input ``F_e`` (the wrench the end effector exerts, which adds
-``+J^T F_e`` to the torques): ``F_ext = -F_e``.  It is the damped
-least-squares solution of ``J^T F = r``, ``F = (J J^T + lambda^2 I)^-1
-J r``: with fewer than six joints (or at a singularity) only its
-component in the range of ``J`` (the directions in which the end
-effector can move, and so can feel a push) is estimated; the rest is
-reported as zero (:func:`felt_directions` gives that range).
+applies, ``tau_ext = J^T F_ext``; :func:`external_wrench` (in
+:mod:`.observer_wrench`) returns ``F_ext``, the wrench the environment
+applies to the end effector, in base axes.
 """
 from dataclasses import dataclass, field
 import math
@@ -68,19 +78,24 @@ import math
 from numba import njit
 import numpy as np
 
-from .calling import (F8, MAT, out_array, PACKED, Refused, status_error,
+from .calling import (F8, MAT, PACKED, Refused, status_error,
                       strict_entry, VEC, vector, workspace)
-from .dynamics import jacobian
+from .drives import DEFAULT_COULOMB_WIDTH
 from .errors import DynamicsInputError
-from .kernels import (cholesky_solve, F_ROWS, F_TOOL, F_TREE, NONFINITE,
-                      run_jacobian, run_momentum_terms, SIZE, T_TOOL)
+from .kernels import NONFINITE, run_momentum_terms, SIZE
 from .kernels._jit import ENTRY, uses_kernels
+from .observer_thresholds import (beyond_friction,  # noqa: F401
+                                  suggest_thresholds)
+from .observer_wrench import external_wrench, felt_directions  # noqa: F401
 from .workspace import Workspace
 
 # this file's compiled functions call kernels: a kernel edit must
 # recompile them (numba's cache stamps a function with its own file only)
 uses_kernels(__file__)
 
+#: s: the static friction allowance decays no faster than this (a
+#: joint's friction settles to the moving friction over some travel)
+ALLOWANCE_HOLD = 0.1
 #: what :func:`observer_step` did with a sample
 UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \
     'restarted', 'duplicate'
@@ -92,22 +107,25 @@ UPDATED, STARTED, RESTARTED, DUPLICATE = 'updated', 'started', \
 # rows of MomentumObserver._buf, the step's buffer (n columns)
 _DQD, _CTQD, _G = 0, 1, 2       # D qd, C^T qd, g (run_momentum_terms)
 _P, _BETA = 3, 4                # momentum and known torque of the sample
-_ARMATURE, _GAIN = 5, 6         # the configuration
-_ROWS = 7
+_ARMATURE, _GAIN = 5, 6         # the configuration: rotor inertia, K,
+_KT, _STATIC, _WIDTH = 7, 8, 9  # torque constant, F_s and eps
+_ROWS = 10
 # the status of a non-finite momentum or known torque at joint i
 _BAD_TORQUE = 2 * NONFINITE
 
 
 @njit(**ENTRY)
-def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
+def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev, fric):
     """
     One sample in one call: D qd, C^T qd, g (one recursion), then S, r.
 
-    p = D qd + armature qd and beta = tau - lost + C^T qd - g; if one is
-    not finite the state is left untouched and ``_BAD_TORQUE`` + the
+    p = D qd + armature qd and beta = K_t tau - lost + C^T qd - g; if one
+    is not finite the state is left untouched and ``_BAD_TORQUE`` + the
     joint returned (a kernel status code for bad q or qd).  Else S and r
-    advance over ``dt`` (``dt <= 0``: S restarts here, keeping r) and -1
-    is returned (-2 if r came out non-finite and was reset to 0).
+    advance over ``dt`` (``dt <= 0``: S restarts here, keeping r), and
+    so does the static friction allowance ``fric[0]`` (``fric[1]``: the
+    bound at this sample), and -1 is returned (-2 if r came out
+    non-finite and was reset to 0).
     """
     code = run_momentum_terms(P, q, qd, ws, cw, buf[:3])
     if code >= 0:
@@ -115,19 +133,25 @@ def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
     n = q.shape[0]
     if (tau.shape[0] != n or lost.shape[0] != n or buf.shape[0] != _ROWS
             or buf.shape[1] != n or S.shape[0] != n or r.shape[0] != n
-            or beta_prev.shape[0] != n):
+            or beta_prev.shape[0] != n or fric.shape[0] != 2
+            or fric.shape[1] != n):
         return SIZE + 2
     for i in range(n):
         p = buf[_DQD, i] + buf[_ARMATURE, i] * qd[i]
-        beta = tau[i] - lost[i] + buf[_CTQD, i] - buf[_G, i]
+        beta = buf[_KT, i] * tau[i] - lost[i] + buf[_CTQD, i] - buf[_G, i]
         if not (math.isfinite(p) and math.isfinite(beta)):
             return _BAD_TORQUE + i
         buf[_P, i] = p
         buf[_BETA, i] = beta
     restart = not dt > 0.0
     ok = True
-    if not restart:
-        for i in range(n):
+    for i in range(n):
+        # what static friction may hold at this speed (0 when moving)
+        bound = buf[_STATIC, i] * (
+            1.0 - abs(math.tanh(qd[i] / buf[_WIDTH, i])))
+        if restart:
+            fric[0, i] = max(fric[0, i], bound)
+        else:
             k = buf[_GAIN, i]
             a = math.exp(-k * dt)
             b = 1.0 - a
@@ -138,6 +162,13 @@ def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
             S[i] += known + r[i] * b / k + u * (dt - b / k)
             r[i] = a * r[i] + b * u
             ok &= math.isfinite(r[i]) and math.isfinite(S[i])
+            # the same lag on the interval's larger bound; falling, no
+            # faster than ALLOWANCE_HOLD (friction lags a start)
+            target = max(bound, fric[1, i])
+            if target < fric[0, i] and k * ALLOWANCE_HOLD > 1.0:
+                a = math.exp(-dt / ALLOWANCE_HOLD)
+            fric[0, i] = a * fric[0, i] + (1.0 - a) * target
+        fric[1, i] = bound
     for i in range(n):
         if not ok or not math.isfinite(r[i]):
             r[i] = 0.0          # cannot happen for finite input; never
@@ -148,89 +179,21 @@ def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev):
 
 
 _step_strict = strict_entry(_step, PACKED, VEC, VEC, VEC, VEC, F8, MAT, MAT,
-                            MAT, VEC, VEC, VEC)
+                            MAT, VEC, VEC, VEC, MAT)
 
 
 @njit(**ENTRY)
-def _dls_wrench(J, r, damping, A, y, F):
+def _contact(r, on, hysteresis, allowance, active):
     """
-    F = (J J^T + damping^2 I)^-1 J r, the damped (J^T)^+ r.
+    Per-joint hysteresis; True when any joint is in contact.
 
-    Six joints or more: the 6 x 6 system.  Fewer: the same F as
-    J (J^T J + damping^2 I)^-1 r, an n x n system that stays well
-    conditioned when J J^T is singular.
+    On above ``on + allowance``, off below ``hysteresis * on +
+    allowance``: the static friction allowance is not scaled (a joint
+    left at the edge of its friction band after a push is released).
     """
-    n = r.shape[0]
-    lam2 = damping * damping
-    if n >= 6:
-        for a in range(6):
-            s = 0.0
-            for j in range(n):
-                s += J[a, j] * r[j]
-            y[a] = s
-            for b in range(a + 1):
-                s = 0.0
-                for j in range(n):
-                    s += J[a, j] * J[b, j]
-                A[a, b] = s
-            A[a, a] += lam2
-        if cholesky_solve(A, y, A, y) != -1:     # in place
-            return False
-        for a in range(6):
-            F[a] = y[a]
-    else:
-        for a in range(n):
-            y[a] = r[a]
-            for b in range(a + 1):
-                s = 0.0
-                for c in range(6):
-                    s += J[c, a] * J[c, b]
-                A[a, b] = s
-            A[a, a] += lam2
-        if cholesky_solve(A, y, A, y) != -1:     # in place
-            return False
-        for c in range(6):
-            s = 0.0
-            for a in range(n):
-                s += J[c, a] * y[a]
-            F[c] = s
-    for a in range(6):
-        if not math.isfinite(F[a]):
-            return False
-    return True
-
-
-@njit(**ENTRY)
-def _wrench(P, q, r, damping, ws, Ts, J, A, y, F):
-    """
-    J(q) and the damped least-squares wrench in one compiled call.
-
-    A kernel status code for q (or SIZE + 1 for r), else -1 with F the
-    wrench, or zeros when the solve fails.
-    """
-    frames = P[P.shape[0] - F_ROWS:]        # the end effector's Jacobian
-    code = run_jacobian(P, q, int(frames[F_TREE, T_TOOL]), frames[F_TOOL],
-                        False, ws, Ts, J)
-    if code >= 0:
-        return code
-    if r.shape[0] != J.shape[1] or F.shape[0] != 6:
-        return SIZE + 1
-    if not _dls_wrench(J, r, damping, A, y, F):
-        for a in range(6):
-            F[a] = 0.0
-    return -1
-
-
-_wrench_strict = strict_entry(_wrench, PACKED, VEC, VEC, F8, MAT, MAT, MAT,
-                              MAT, VEC, VEC)
-
-
-@njit(**ENTRY)
-def _contact(r, on, hysteresis, active):
-    """Per-joint hysteresis; True when any joint is in contact."""
     any_active = False
     for i in range(r.shape[0]):
-        x = abs(r[i])
+        x = abs(r[i]) - allowance[i]
         if active[i]:
             active[i] = x > hysteresis * on[i]
         else:
@@ -273,13 +236,23 @@ class MomentumObserver:
         ``qdd=None`` (the observer has no acceleration).
     armature : optional per-joint reflected rotor inertia, added to the
         diagonal of D in the momentum.
+    torque_constant : optional per-joint N m (or N) per effort unit: the
+        efforts are multiplied by it (a current-sensing arm's amperes
+        become joint torques); None: the efforts are torques.
+    static_friction : optional per-joint torque (N m or N) static
+        friction may hold at rest; the contact test allows for it near
+        zero speed (module docstring).  None or 0: no allowance.
+    friction_width : per-joint speed (rad/s or m/s) over which that
+        allowance fades, the Coulomb friction's tanh width (0.02).
     damping : lambda of the damped least-squares wrench (same units as
         J: metres and 1); larger trades accuracy near singularities for
         a bounded estimate.
     thresholds : per-joint contact thresholds on |r| (N m or N), one
-        value or one per joint (model order).
+        value or one per joint (model order), on top of the static
+        friction allowance.
     hysteresis : a joint in contact is released when |r| falls below
-        this fraction of its threshold (0 < hysteresis <= 1).
+        this fraction of its threshold, plus the allowance
+        (0 < hysteresis <= 1).
     ws : a :class:`Workspace` of the model (a new one by default); not
         shared with another thread.
 
@@ -287,13 +260,14 @@ class MomentumObserver:
 
     def __init__(self, model, gain=50.0, *, max_gap=0.1, drive_torque=None,
                  armature=None, damping=0.01, thresholds=10.0,
-                 hysteresis=0.5, ws=None):
+                 hysteresis=0.5, torque_constant=None, static_friction=None,
+                 friction_width=DEFAULT_COULOMB_WIDTH, ws=None):
         n = model.n
         self.model = model
         self.n = n
         self.ws = Workspace(model) if ws is None else workspace(model, ws)
         # the compiled step's buffer: the model terms, p and beta of the
-        # last sample, the armature and the gain (rows _DQD ... _GAIN)
+        # last sample, then the configuration (rows _DQD ... _WIDTH)
         self._buf = np.zeros((_ROWS, n))
         # gain and armature: views of rows of it (change them in place)
         self.gain = self._buf[_GAIN]
@@ -309,6 +283,17 @@ class MomentumObserver:
         self.armature = self._buf[_ARMATURE]
         if armature is not None:
             self.armature[:] = _per_joint('armature', armature, n, False)
+        self.torque_constant = None if torque_constant is None else \
+            _per_joint('torque_constant', torque_constant, n)
+        self._buf[_KT] = 1.0 if torque_constant is None else \
+            self.torque_constant
+        self.static_friction = self._buf[_STATIC]
+        if static_friction is not None:
+            self.static_friction[:] = _per_joint('static_friction',
+                                                 static_friction, n, False)
+        self.friction_width = self._buf[_WIDTH]
+        self.friction_width[:] = _per_joint('friction_width',
+                                            friction_width, n)
         self.damping = float(damping)
         if not (math.isfinite(self.damping) and self.damping >= 0.0):
             raise ValueError(f'damping: must be finite and >= 0, got '
@@ -322,6 +307,7 @@ class MomentumObserver:
         self.p = self._buf[_P]          # momentum of the last sample
         self.beta = self._buf[_BETA]    # its known torque
         self.lost = np.zeros(n)
+        self._no_allowance = np.zeros(n)
         self._A = np.zeros((min(n, 6), min(n, 6)))
         self._y = np.zeros(min(n, 6))
         self._packed = model.packed
@@ -333,7 +319,7 @@ class MomentumObserver:
         observer_step(self, state, 0.0, z, z, z)
         observer_step(self, state, 1e-3, z, z, z)
         external_wrench(self, z, state.r)
-        contact_step(self, initial_contact(self), state.r)
+        contact_step(self, initial_contact(self), state.r, state.allowance)
 
 
 def drive_terms(model):
@@ -363,6 +349,38 @@ def drive_terms(model):
     return drive_torque, armature
 
 
+def drive_options(model, static_friction=1.5):
+    """
+    Return :class:`MomentumObserver` keyword arguments from a model's drives.
+
+    ``drive_torque`` and ``armature`` (:func:`drive_terms`), the
+    ``torque_constant`` (None unless the URDF gives it: the efforts are
+    then torques), and the static friction allowance: ``static_friction``
+    times each joint's Coulomb friction (URDF ``<dynamics friction>``, as
+    identify writes it), fading over its tanh width.  The default 1.5:
+    static friction is commonly 20-50 % above the Coulomb level, which an
+    identification gives within some 10 %.  0 leaves the allowance out.
+    """
+    ratio = float(static_friction)
+    if not (math.isfinite(ratio) and ratio >= 0.0):
+        raise ValueError(f'static_friction: must be finite and >= 0, got '
+                         f'{static_friction!r}')
+    drive, armature = drive_terms(model)
+    out = {'drive_torque': drive, 'armature': armature}
+    info = getattr(model, 'info', None) or {}
+    drives = info.get('drives') if isinstance(info, dict) else None
+    constant = getattr(drives, 'torque_constant', None)
+    if constant is not None:
+        out['torque_constant'] = constant
+    coulomb = getattr(drives, 'coulomb', None)
+    if drive is not None and coulomb is not None and ratio > 0.0:
+        out['static_friction'] = ratio * np.asarray(coulomb, dtype=float)
+        width = getattr(drives, 'coulomb_width', None)
+        if width is not None:
+            out['friction_width'] = width
+    return out
+
+
 @dataclass
 class ObserverState:
     """What the observer carries between samples: no history."""
@@ -370,10 +388,18 @@ class ObserverState:
     S: np.ndarray           # running sum p(0) + integral, model order
     r: np.ndarray           # residual (external joint torque estimate)
     beta_prev: np.ndarray   # known torque at the previous sample
+    # (2, n): the static friction allowance, and its bound at the
+    # previous sample
+    friction: np.ndarray = None
     t_prev: float = None    # stamp of the previous sample (None: none)
     samples: int = 0        # samples used
     restarts: int = 0       # gaps and stamps going backwards
     duplicates: int = 0     # samples with the previous sample's stamp
+
+    @property
+    def allowance(self):
+        """Per joint, what static friction may add to |r| now (a view)."""
+        return self.friction[0]
 
 
 @dataclass
@@ -388,7 +414,8 @@ class ContactState:
 def initial_state(obs):
     """Return a state before any sample: the first one starts the sum."""
     n = obs.n
-    return ObserverState(np.zeros(n), np.zeros(n), np.zeros(n))
+    return ObserverState(np.zeros(n), np.zeros(n), np.zeros(n),
+                         np.zeros((2, n)))
 
 
 def initial_contact(obs):
@@ -400,8 +427,9 @@ def observer_step(obs, state, t, q, qd, tau):
     """
     Use one sample at stamp ``t`` (seconds); return the residual.
 
-    ``q``, ``qd``, ``tau`` (efforts) are float64 arrays in model order.
-    Returns ``(r, what)`` with ``r`` the state's residual (a view, updated
+    ``q``, ``qd``, ``tau`` (efforts: joint torques, or efforts the
+    observer's ``torque_constant`` turns into torques) are float64 arrays
+    in model order.  Returns ``(r, what)`` with ``r`` the state's residual (a view, updated
     in place; copy to keep it) and ``what`` one of ``UPDATED``,
     ``STARTED`` (first sample), ``RESTARTED`` (gap or stamp backwards),
     ``DUPLICATE`` (same stamp: ignored).  Non-finite or wrongly sized
@@ -432,7 +460,7 @@ def observer_step(obs, state, t, q, qd, tau):
     try:
         code = _step_strict(obs._packed, q, qd, tau, lost, dt, obs.ws.ws,
                             obs.ws.cw, obs._buf, state.S, state.r,
-                            state.beta_prev)
+                            state.beta_prev, state.friction)
     except Refused:                 # not float64 arrays: convert, again
         code = None
     if code is None or code >= 0:
@@ -452,7 +480,7 @@ def _step_converted(obs, state, q, qd, tau, lost, dt):
     try:
         code = _step_strict(obs._packed, q, qd, tau, vector('lost', lost, n),
                             dt, obs.ws.ws, obs.ws.cw, obs._buf, state.S,
-                            state.r, state.beta_prev)
+                            state.r, state.beta_prev, state.friction)
     except Refused:
         raise DynamicsInputError('state: not made by initial_state') from None
     if code < 0:
@@ -479,58 +507,21 @@ def _vector(name, x, n):
     return x
 
 
-def external_wrench(obs, q, r, out=None):
+def contact_step(obs, contact, r, allowance=None):
     """
-    Return F_ext (6,), the wrench the environment applies to the tool.
+    Update ``contact`` from the residual; return whether in contact.
 
-    ``[fx, fy, fz, mx, my, mz]`` in base axes, moment about the
-    end-effector origin (force/torque sensor sign; ``-F_e`` of the
-    dynamics' input convention), the damped least-squares solution of
-    ``J(q)^T F = r``.  Zeros if the solve fails (never NaN).  One
-    compiled call (``_wrench``): J(q), then the solve.
+    ``allowance``: the state's static friction allowance
+    (``state.allowance``), added to every threshold; None: none.
     """
-    F = np.empty(6) if out is None else out
-    try:
-        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
-                              obs.ws.frames, obs.J, obs._A, obs._y, F)
-    except Refused:                 # not float64 arrays: convert, again
-        code = None
-    if code is None or code >= 0:
-        q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
-            out, (6,))
-        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
-                              obs.ws.frames, obs.J, obs._A, obs._y, F)
-        if code >= 0:
-            raise status_error(code, (q,))
-    return F
-
-
-def contact_step(obs, contact, r):
-    """Update ``contact`` from the residual; return whether in contact."""
-    now = _contact(r, obs.thresholds, obs.hysteresis, contact.active)
+    if allowance is None:
+        allowance = obs._no_allowance
+    now = _contact(r, obs.thresholds, obs.hysteresis, allowance,
+                   contact.active)
     if now and not contact.in_contact:
         contact.count += 1
     contact.in_contact = bool(now)
     return contact.in_contact
-
-
-def felt_directions(obs, q, tol=1e-6):
-    """
-    Return an orthonormal basis (6, k) of the wrenches the arm feels at q.
-
-    The range of J(q) (``[f; m]`` in base axes, moment about the
-    end-effector origin): the estimate of :func:`external_wrench` is the
-    projection of the true wrench onto it (for small damping).  ``k`` is
-    6 for a six- or seven-joint arm away from singularities; a planar
-    three-joint arm feels fx, fy and mz; a planar two-joint arm only two
-    combinations of them.  Columns with singular values below ``tol``
-    times the largest are left out.
-    """
-    J = jacobian(obs.model, q, 'base', ws=obs.ws)
-    U, s, _ = np.linalg.svd(J, full_matrices=False)
-    if not s.size or not s[0] > 0.0:
-        return np.zeros((6, 0))
-    return U[:, s > tol * s[0]]
 
 
 @dataclass
@@ -545,6 +536,7 @@ class ObserverRecording:
     contacts: int = 0               # contacts begun
     restarts: int = 0
     skipped: int = 0                # rows with non-finite input
+    allowance: np.ndarray = None    # (m, n) static friction allowance
 
 
 def observe_recording(obs, T, Q, QD, TAU):
@@ -567,7 +559,8 @@ def observe_recording(obs, T, Q, QD, TAU):
         arrays.append(X)
     Q, QD, TAU = arrays
     out = ObserverRecording(T.copy(), np.zeros((m, n)), np.zeros((m, 6)),
-                            np.zeros(m, dtype=np.bool_), [])
+                            np.zeros(m, dtype=np.bool_), [],
+                            allowance=np.zeros((m, n)))
     state, contact = initial_state(obs), initial_contact(obs)
     F = np.zeros(6)
     for k in range(m):
@@ -575,11 +568,12 @@ def observe_recording(obs, T, Q, QD, TAU):
             r, what = observer_step(obs, state, T[k], Q[k], QD[k], TAU[k])
             if what != DUPLICATE:
                 external_wrench(obs, Q[k], r, out=F)
-                contact_step(obs, contact, r)
+                contact_step(obs, contact, r, state.allowance)
         except DynamicsInputError:
             out.skipped += 1
             what = 'skipped'
         out.residual[k] = state.r
+        out.allowance[k] = state.allowance
         out.wrench[k] = F
         out.contact[k] = contact.in_contact
         out.status.append(what)

@@ -16,13 +16,15 @@
 inverse_dynamics_node's momentum observer (``observer.*`` parameters).
 
 The ROS side of ``core.observer``: after the torques of a JointState are
-published, :meth:`NodeObserver.observe` runs one observer step on it and
-publishes ``~/external_torque`` (JointState, effort field),
-``~/external_wrench`` (WrenchStamped, base frame) and, on every change,
-``~/contact`` (Bool; also at ``observer.contact_period``).  Its state and
-counters go to ``/diagnostics`` (:meth:`NodeObserver.diagnostics`).  It
-never raises into the node: a sample it cannot use is counted and
-skipped, and JointStates without effort or velocity are reported once.
+published, :meth:`NodeObserver.observe` runs one observer step on it (its
+efforts converted to joint torques through the URDF's torque constants
+when it has them: a current-sensing arm) and publishes
+``~/external_torque`` (JointState, effort field), ``~/external_wrench``
+(WrenchStamped, base frame) and, on every change, ``~/contact`` (Bool;
+also at ``observer.contact_period``).  Its state and counters go to
+``/diagnostics`` (:meth:`NodeObserver.diagnostics`).  It never raises
+into the node: a sample it cannot use is counted and skipped, and
+JointStates without effort or velocity are reported once.
 """
 import functools
 
@@ -90,19 +92,29 @@ class NodeObserver:
         p = self.params
         model = ff.model
         scene = ff.scene
-        # the model's own drives (an identified URDF), or the scene's
-        drive, armature = momentum.drive_terms(model)
+        # the model's own drives (an identified URDF: friction, rotor
+        # inertia, torque constants), or the scene's
+        ratio = p['observer.static_friction']
+        options = momentum.drive_options(model, ratio)
         if scene is not None and scene.effects.friction:
-            drive = functools.partial(_scene_friction, scene)
+            options['drive_torque'] = functools.partial(_scene_friction,
+                                                        scene)
+            options['static_friction'] = ratio * scene.coulomb
         if scene is not None and scene.effects.armature:
-            armature = scene.armature
+            options['armature'] = scene.armature
         obs = momentum.MomentumObserver(
             model, p['observer.gain'], max_gap=p['observer.max_gap'],
-            drive_torque=drive, armature=armature,
             damping=p['observer.damping'],
             thresholds=_per_joint('observer.thresholds',
                                   p['observer.thresholds'], model),
-            hysteresis=_at_most_one(p['observer.hysteresis']))
+            hysteresis=_at_most_one(p['observer.hysteresis']), **options)
+        if obs.torque_constant is not None and 'constants' not in self.said:
+            self.said.add('constants')
+            self.node.get_logger().info(
+                'observer: efforts converted to joint torques with the '
+                "URDF's torque constants " + ', '.join(
+                    f'{k:.4g}' for k in obs.torque_constant)
+                + ' (N m per effort unit); thresholds in N m')
         obs.warm_up()
         old = self.state
         state = momentum.initial_state(obs)
@@ -151,7 +163,8 @@ class NodeObserver:
             return None
         F = momentum.external_wrench(obs, ff.last_q, r, out=self._wrench_out)
         before = self.contact.in_contact
-        now = momentum.contact_step(obs, self.contact, r)
+        now = momentum.contact_step(obs, self.contact, r,
+                                    self.state.allowance)
         self.status = 'running'
         return r, F, before, now
 
@@ -222,7 +235,9 @@ class NodeObserver:
             KeyValue(key='rejected', value=str(self.rejected)),
             KeyValue(key='gain', value=repr(self.params['observer.gain'])),
             KeyValue(key='thresholds', value=repr(
-                list(self.params['observer.thresholds'])))]
+                list(self.params['observer.thresholds']))),
+            KeyValue(key='static_friction', value=repr(
+                self.params['observer.static_friction']))]
         return status
 
 

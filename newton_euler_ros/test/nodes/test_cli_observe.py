@@ -20,14 +20,19 @@ its efforts come from the Euler-Lagrange oracle for a Puma 560 URDF that
 moves slowly while the environment pushes on its tool from 1.0 s to
 2.0 s.  The CSV must show the push as the external wrench and the
 contact over that window; bad inputs are one line and exit status 2.
+``--json`` prints one object, per joint in chain order; efforts in A
+with the URDF's torque constants give the torques' results; the
+threshold procedure holds on a current-sensing arm that stops.
 """
 import csv
+import json
 import os
 import subprocess
 import sys
 import warnings
 
 from newton_euler_ros.core import load_robot
+from newton_euler_ros.core.drives import DRIVES_NS
 from newton_euler_ros.ident.bag import write_joint_states
 import numpy as np
 import pytest
@@ -36,6 +41,7 @@ import reference_dynamics as ref
 pytest.importorskip('rosbags')
 
 PUSH = np.array([15.0, 0.0, -25.0, 0.0, 0.0, 0.0])
+CONSTANTS = np.array([11.0, 13.5, 9.0, 4.2, 3.9, 3.1])    # N m per A
 T_ON, T_OFF = 1.0, 2.0
 
 
@@ -74,8 +80,29 @@ def files(tmp_path_factory):
     write_joint_states(bag, stamps, model.joint_names, Q, QD, TAU)
     no_velocity = str(tmp / 'no_velocity')
     write_joint_states(no_velocity, stamps, model.joint_names, Q, None, TAU)
+    # the same, the message's joints in another order
+    reversed_bag = str(tmp / 'reversed')
+    write_joint_states(reversed_bag, stamps, model.joint_names[::-1],
+                       *(np.ascontiguousarray(X[:, ::-1])
+                         for X in (Q, QD, TAU)))
+    # the same arm reporting motor currents (A): effort = tau / K, and its
+    # URDF with the torque constants K (N m per A)
+    current_urdf = str(tmp / 'puma_current.urdf')
+    with open(urdf, encoding='utf-8') as fh:
+        text = fh.read()
+    text = text.replace('<robot ', f'<robot xmlns:ne="{DRIVES_NS}" ', 1)
+    for name, k in zip(model.joint_names, CONSTANTS):
+        head = f'<joint name="{name}" type="revolute">'
+        assert head in text
+        text = text.replace(head, head + f'<ne:drive torque_constant="{k}"/>')
+    with open(current_urdf, 'w', encoding='utf-8') as fh:
+        fh.write(text)
+    current = str(tmp / 'current')
+    write_joint_states(current, stamps, model.joint_names, Q, QD,
+                       TAU / CONSTANTS)
     return {'tmp': tmp, 'urdf': urdf, 'bag': bag, 't': t, 'model': model,
-            'no_velocity': no_velocity}
+            'no_velocity': no_velocity, 'reversed': reversed_bag,
+            'current_urdf': current_urdf, 'current': current}
 
 
 def test_observe_recovers_the_push_from_a_bag(files):
@@ -137,3 +164,100 @@ def test_bad_inputs_are_one_line_and_exit_2(files, case):
     assert expect[-1] in lines[0], lines[0]
     assert 'Traceback' not in err
     assert not os.path.exists(tmp / 'bad.csv')
+
+
+def observe_json(*args):
+    code, out, err = run(*args, '--json')
+    assert code == 0, err
+    summary = json.loads(out)        # the whole output: one JSON object
+    assert isinstance(summary, dict)
+    return summary
+
+
+def test_json_is_one_object_per_joint_in_chain_order(files):
+    model, tmp = files['model'], files['tmp']
+    before = set(os.listdir(tmp))
+    args = ['--base', 'base_link', '--tip', 'tool0', '--gain', '40',
+            '--thresholds', '2.0']
+    s = observe_json(files['urdf'], files['bag'], *args)
+    names = list(model.joint_names)
+    assert s['joints'] == names
+    for key in ('suggested_thresholds', 'thresholds', 'peak', 'rms',
+                'peak_beyond_friction', 'friction_allowance'):
+        assert len(s[key]) == model.n, key
+    assert s['torque_constant'] is None       # the efforts are torques
+    assert s['samples'] == files['t'].size and s['contacts'] == 1
+    (start, end), = s['contact_intervals']
+    assert T_ON <= start < T_ON + 0.1 and T_OFF <= end < T_OFF + 0.5
+    # what the CSV holds, in the CSV's joint order
+    assert not set(os.listdir(tmp)) - before          # no --csv: no file
+    out_csv = str(tmp / 'json.csv')
+    observe_json(files['urdf'], files['bag'], *args, '--csv', out_csv)
+    with open(out_csv, newline='') as fh:
+        rows = list(csv.DictReader(fh))
+    peak = [max(abs(float(r[f'tau_ext_{j}'])) for r in rows) for j in names]
+    np.testing.assert_allclose(s['peak'], peak, rtol=1e-5, atol=1e-6)
+    # the joints in another order in the messages: the same, chain order
+    r = observe_json(files['urdf'], files['reversed'], *args)
+    assert r['joints'] == names
+    np.testing.assert_allclose(r['peak'], s['peak'], rtol=1e-12)
+    assert r['suggested_thresholds'] == s['suggested_thresholds']
+
+
+def test_currents_with_torque_constants_give_the_torques_results(files):
+    args = ['--base', 'base_link', '--tip', 'tool0', '--gain', '40',
+            '--thresholds', '2.0']      # N m, whatever the effort's unit
+    torque = observe_json(files['urdf'], files['bag'], *args)
+    current = observe_json(files['current_urdf'], files['current'], *args)
+    np.testing.assert_allclose(current['torque_constant'], CONSTANTS)
+    np.testing.assert_allclose(current['peak'], torque['peak'], rtol=1e-6)
+    assert current['contacts'] == 1
+    assert current['contact_intervals'] == torque['contact_intervals']
+    # the table says what it did
+    code, out, err = run(files['current_urdf'], files['current'], *args)
+    assert code == 0, err
+    assert 'torque constants 11, 13.5, 9, 4.2, 3.9, 3.1' in out
+    # read as N m, the currents are a wrong arm: contact all along
+    raw = observe_json(files['urdf'], files['current'], *args)
+    assert raw['contact_fraction'] > 0.9
+
+
+def test_thresholds_from_a_free_recording_with_stops(tmp_path):
+    """
+    The procedure on a current-sensing arm that stops and rests.
+
+    Two free-motion recordings of the current-sensing example arm (a
+    UR5, motor currents, stops of 0.3-2.5 s where static friction holds
+    up to 1.2-1.5 x its Coulomb level): the thresholds suggested by the
+    first give no contact on the second.  Without the static friction
+    allowance, the stops alone would call for thresholds above the
+    shoulder's Coulomb friction.
+    """
+    from newton_euler_tools import current_arm_example as arm_example
+    from newton_euler_tools.current_arm_model import identified_urdf
+    from newton_euler_tools.current_arm_motions import point_to_point
+    arm = arm_example.real_arm(3)
+    urdf = str(tmp_path / 'arm.urdf')
+    with open(urdf, 'w', encoding='utf-8') as fh:
+        fh.write(identified_urdf(arm.to_json(), 3))
+    bags = []
+    for k in (1, 2):
+        bags.append(str(tmp_path / f'free_{k}'))
+        arm_example.record(arm, bags[-1], point_to_point(
+            300 + k, 30.0, dwell=(0.3, 2.5), few=0.3, reverse=0.7),
+            seed=30 + k)
+    chain = ['--base', 'base_link', '--tip', 'tool0']
+    first = observe_json(urdf, bags[0], *chain)
+    assert first['resting_fraction'] > 0.1         # it does stop
+    suggested = first['suggested_thresholds']
+    coulomb = np.asarray(arm.drives['coulomb'])
+    assert np.all(np.asarray(suggested)[:3] < 0.6 * coulomb[:3]), suggested
+    second = observe_json(urdf, bags[1], *chain, '--thresholds',
+                          *map(str, suggested))
+    assert second['contacts'] == 0, second
+    assert second['contact_fraction_at_rest'] == 0.0
+    # the same procedure with the allowance off: the held friction sets
+    # the thresholds, above the shoulder's Coulomb friction
+    bare = observe_json(urdf, bags[0], *chain, '--static-friction', '0')
+    assert np.all(np.asarray(bare['suggested_thresholds'])[:2]
+                  > coulomb[:2]), bare['suggested_thresholds']
