@@ -42,7 +42,11 @@ arrival time as the recording time: what ``identify``, ``payload`` and
 ``observe`` read, without the ``ros2`` CLI.  Its subscription is reliable
 unless a publisher on the topic is best effort.  It stops after
 ``--duration`` seconds of recording, ``--max-messages`` messages, or on
-Ctrl-C (SIGINT) or SIGTERM; the bag is complete in every case.
+Ctrl-C (SIGINT), SIGTERM or SIGHUP (a closed terminal or ssh session);
+the bag is complete in every case.  What it has recorded reaches the disk
+every ``SYNC_S`` seconds (a closed MCAP chunk, fsynced; a committed
+sqlite3 transaction), so a SIGKILL or a power cut loses at most that
+much, and the reading commands recover the rest.
 
 Both need rclpy (the ROS 2 wheels of ``make setup``); every other command
 of ``newton-euler`` runs without it.
@@ -60,6 +64,7 @@ MAX_TRAJECTORY_BYTES = 64 * 1024 * 1024
 MAX_POINTS = 1_000_000
 FIELDS = ('positions', 'velocities', 'accelerations', 'effort')
 JOINT_STATE = 'sensor_msgs/msg/JointState'
+SYNC_S = 0.5          # record: what is recorded is on the disk this often
 
 
 class RosCliError(Exception):
@@ -199,7 +204,7 @@ def trajectory_message(names, points, stamp_ns):
 # ---- running on a graph ----------------------------------------------------
 
 class _Ros:
-    """rclpy in a context of its own, stopped by SIGINT and SIGTERM."""
+    """rclpy in a context of its own, stopped by SIGINT, SIGTERM, SIGHUP."""
 
     def __init__(self, name):
         import rclpy
@@ -207,7 +212,7 @@ class _Ros:
         from rclpy.signals import SignalHandlerOptions
         self.stop = []
         self._old = {}
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
             self._old[sig] = signal.signal(
                 sig, lambda signum, frame: self.stop.append(signum))
         self.rclpy = rclpy
@@ -443,10 +448,19 @@ class _Recorder:
         self.first = self.last = None
 
     def start(self):
-        from .ident.bag import open_writer
+        from .ident.bag import open_writer, sync_directory, sync_writer
         self.writer, self.conn, _ = open_writer(self.args.bag,
                                                 self.args.topic,
                                                 self.args.storage)
+        self._sync = sync_writer
+        sync_writer(self.writer)
+        sync_directory(self.args.bag)
+        sync_directory(os.path.dirname(os.path.abspath(self.args.bag)))
+
+    def sync(self):
+        """Put what is recorded on the disk (a timer calls it)."""
+        if self.writer is not None and self.count:
+            self._sync(self.writer)
 
     def __call__(self, raw):
         now = time.time_ns()
@@ -518,9 +532,10 @@ def cmd_record(args):
             JointState, topic, rec, QoSProfile(
                 depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT
                 if best_effort else ReliabilityPolicy.RELIABLE), raw=True)
-        print(f'recording {topic} into {args.bag} '
-              f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
-              f'stops', flush=True)
+        ros.node.create_timer(SYNC_S, rec.sync)
+        _say(f'recording {topic} into {args.bag} '
+             f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
+             f'stops')
         ros.spin_until(rec.done, None)
     finally:
         rec.close()
@@ -528,10 +543,26 @@ def cmd_record(args):
     if not rec.count:
         if rec.writer is not None:
             shutil.rmtree(args.bag, ignore_errors=True)
-        print(f'newton-euler: no message received on {args.topic}; no bag '
-              f'written', file=sys.stderr)
+        _say(f'newton-euler: no message received on {args.topic}; no bag '
+             f'written', sys.stderr)
         return 1
     seconds = (rec.last - rec.first) * 1e-9
-    print(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
-          f'into {args.bag}', flush=True)
+    how = {signal.SIGINT: ' (Ctrl-C)', signal.SIGTERM: ' (SIGTERM)',
+           signal.SIGHUP: ' (SIGHUP)'}.get(ros.stop[0] if ros.stop else None,
+                                           '')
+    _say(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
+         f'into {args.bag}{how}')
     return 0
+
+
+def _say(text, stream=None):
+    """Print a line; a terminal gone (SIGHUP) is no error: drop it."""
+    stream = sys.stdout if stream is None else stream
+    try:
+        print(text, file=stream, flush=True)
+    except OSError:
+        # stdout and stderr to /dev/null, so that the exit flush cannot
+        # fail either
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)

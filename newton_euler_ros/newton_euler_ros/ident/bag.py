@@ -418,6 +418,41 @@ def open_writer(path, topic=DEFAULT_TOPIC, storage='mcap'):
     return writer, conn, ts
 
 
+def sync_writer(writer):
+    """
+    Put what ``writer`` (from :func:`open_writer`) has so far on the disk.
+
+    MCAP: the pending chunk is closed (a complete chunk record, readable
+    without the summary a close writes) and the file flushed and fsynced;
+    sqlite3: the open transaction is committed (sqlite syncs on commit).
+    After it, a killed process or a power cut loses nothing written
+    before.  rosbags' writers keep the file and the pending chunk in
+    ``writer.storage`` (rosbags 0.11).
+    """
+    import os
+    storage = writer.storage
+    if storage is None:
+        return
+    conn = getattr(storage, 'conn', None)
+    if conn is not None:                            # sqlite3
+        conn.commit()
+        return
+    if storage.chunk.msgs:                          # MCAP
+        storage.close_chunk()
+    storage.bio.flush()
+    os.fsync(storage.bio.fileno())
+
+
+def sync_directory(path):
+    """Fsync a directory, so that the files just created in it survive."""
+    import os
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
 def write_joint_states(path, stamps_ns, names, q, qd, effort,
                        topic=DEFAULT_TOPIC, storage='mcap',
                        logtimes_ns=None):
