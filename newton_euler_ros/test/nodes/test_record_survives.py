@@ -18,8 +18,10 @@ A recording survives its recorder: ``newton-euler record`` as processes.
 A driver stand-in publishes JointState at 100 Hz over DDS while
 ``record`` writes them.  Closed by SIGHUP (a dropped ssh session) or
 SIGTERM, the bag is complete.  Killed by SIGKILL (a crash, a power cut),
-what it left has no metadata.yaml and an unfinished storage file (read
-by the recovery tests).
+what it left has no metadata.yaml and an unfinished storage file, and
+``replay``, ``observe`` and identify's reader read it, saying in one line
+what they recovered: the messages published up to at most a second
+before the kill.
 """
 import os
 import re
@@ -143,3 +145,49 @@ def test_sighup_and_sigterm_leave_a_complete_bag(tmp_path, sig):
     _contiguous(states.stamps_ns, sent)
     # nothing lost but what was still on its way when the signal came
     assert (sent[-1] - states.stamps_ns[-1]) * 1e-9 < 0.2
+
+
+# killed at different phases of record's half-second sync
+@pytest.mark.parametrize('storage, seconds', [('mcap', 3.25),
+                                              ('sqlite3', 3.45)])
+def test_sigkill_loses_at_most_a_second(tmp_path, storage, seconds):
+    domain = domain_id(51 + len(storage))
+    bag, code, out, err, sent, (t0, before) = _record(
+        tmp_path, domain, storage, seconds, signal.SIGKILL)
+    assert code == -signal.SIGKILL
+    assert not (bag / 'metadata.yaml').exists()
+    # identify's reader: a run of what was published, up to at most a
+    # second before the kill
+    states = read_joint_states(str(bag), NAMES)
+    assert len(states.notes) == 1 and 'no metadata.yaml' in states.notes[0]
+    _contiguous(states.stamps_ns, sent)
+    # the last message kept was published at most a second before the
+    # kill (wall clock)
+    lost = before[int(states.stamps_ns[-1])]
+    print(f'{storage}: {len(states)} messages recovered, the last one '
+          f'published {lost:.3f} s before the kill')
+    assert 0.0 <= lost <= LOST_AT_MOST, lost
+    assert len(states) > 1.5 * RATE        # over 1.5 s of 3 s kept
+    np.testing.assert_allclose(
+        states.q[:, 0], 0.3 * np.sin(np.pi * (states.stamps_ns - t0) * 1e-9),
+        atol=1e-12)
+    # replay and observe read it too, and say in one line what they read
+    urdf = tmp_path / 'puma560.urdf'
+    assert _cli('urdf', 'puma560', '-o', str(urdf), domain=domain) \
+        .returncode == 0
+    said = re.compile(rf'warning: recording {re.escape(str(bag))}: no '
+                      rf'metadata.yaml; .*recovered {len(states)} messages '
+                      rf'on /joint_states up to t = [0-9.]+ s from bag\.')
+    replay = _cli('replay', str(urdf), str(bag), '--base', 'base_link',
+                  '--tip', 'tool0', '--csv', str(tmp_path / 'r.csv'),
+                  domain=domain)
+    assert replay.returncode == 0, replay.stderr
+    lines = [x for x in replay.stderr.splitlines() if 'recovered' in x]
+    assert len(lines) == 1 and said.match(lines[0]), replay.stderr
+    rows = (tmp_path / 'r.csv').read_text().splitlines()
+    assert 0 < len(rows) - 1 <= len(states)
+    observe = _cli('observe', 'puma560', str(bag), '--csv',
+                   str(tmp_path / 'o.csv'), domain=domain)
+    assert observe.returncode == 0, observe.stderr
+    lines = [x for x in observe.stderr.splitlines() if 'recovered' in x]
+    assert len(lines) == 1 and said.match(lines[0]), observe.stderr
