@@ -85,8 +85,9 @@ def register(subparsers):
                           'now (0: a zero stamp, "start on receipt"; '
                           'default %(default)s)')
     snd.add_argument('--wait', type=float, default=10.0, metavar='S',
-                     help='seconds to wait for a subscriber (default '
-                          '%(default)s)')
+                     help="seconds to wait for a subscriber, the robot's "
+                          'joint states and its arrival at the start '
+                          '(default %(default)s)')
     snd.add_argument('--no-follow', action='store_true',
                      help='return once the message is acknowledged, not '
                           'when the trajectory ends')
