@@ -27,11 +27,12 @@
     newton-euler send TRAJECTORY.json | record BAG   (on a live ROS graph)
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
-(``.urdf``, with ``--base LINK --tip LINK`` to choose the chain).  Every
-error is one line on stderr.  Exit status: 0 done; 1 an input is unusable
-(a robot, scene, states or trajectory file, or a value in it); 2 the
-command line is wrong (unknown command or option, missing or malformed
-argument); 130 interrupted.
+(``.urdf``, or XML under any name, with ``--base LINK --tip LINK`` to
+choose the chain).  Every error is one line on stderr.  Exit status, the
+same for every command (docs/cli.md): 0 done; 1 the inputs were usable
+but the work failed (the ROS graph did not answer: no subscriber or
+publisher in time, nothing recorded; an internal error); 2 an input is
+wrong (the command line, or a file or value it names); 130 interrupted.
 """
 import argparse
 import json
@@ -42,14 +43,18 @@ import numpy as np
 from .cli_identify import register as register_identify
 from .cli_loop import register as register_loop
 from .cli_observe import register as register_observe
-from .cli_ros import register as register_ros, RosCliError
+from .cli_ros import register as register_ros, RosCliError, RosGraphError
 from .core import (coriolis_matrix, gravity_torques, inspect_robot,
                    inverse_dynamics, jacobian, mass_matrix, NewtonEulerError,
                    RobotFileError)
 from .core.robot_file import bundled_robots, Note, read_text, to_number
 
-EXIT_USAGE = 2
-EXIT_ERROR = 1
+# the exit statuses of every command (docs/cli.md states the rule)
+EXIT_DONE = 0
+EXIT_FAILED = 1         # usable inputs, but the work failed
+EXIT_BAD_INPUT = 2      # the command line, or a file or value it names
+EXIT_USAGE = EXIT_BAD_INPUT
+EXIT_INTERRUPTED = 130
 MAX_JSON_BYTES = 64 * 1024 * 1024
 
 
@@ -58,7 +63,7 @@ class CliError(Exception):
 
 
 class InputError(NewtonEulerError):
-    """An input file or value is unusable (exit status 1)."""
+    """An input file or value is unusable (exit status 2)."""
 
 
 def _read_json(path):
@@ -259,6 +264,8 @@ def cmd_check(args):
               f'{", ".join(report["merged_fixed"]) or "none"}')
         print(f'  lumped off-chain subtrees (at zero position): '
               f'{", ".join(report["lumped"]) or "none"}')
+        print(f'  locked off-chain moving joints: '
+              f'{", ".join(report.get("locked", ())) or "none"}')
         print(f'  continuous joints: '
               f'{", ".join(report["continuous"]) or "none"}')
     print(f'  total mass: {model.total_mass:.6g} kg')
@@ -356,12 +363,14 @@ class _Parser(argparse.ArgumentParser):
         raise CliError(message)
 
 
+ROBOT_HELP = 'robot YAML or URDF file, or bundled robot name'
+
+
 def build_parser():
     parser = _Parser(prog='newton-euler', description=__doc__.strip().split('\n')[0])
     sub = parser.add_subparsers(dest='command', parser_class=_Parser)
     dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
-    dyn.add_argument('robot', help='robot YAML or URDF file, or bundled '
-                                   'robot name')
+    dyn.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     _chain_options(dyn)
     dyn.add_argument('--q', nargs='+', metavar='Q',
                      help='joint positions (rad or m)')
@@ -383,18 +392,19 @@ def build_parser():
                           ' and print a JSON list')
     dyn.set_defaults(func=cmd_dynamics)
     chk = sub.add_parser('check', help='validate a robot file')
-    chk.add_argument('robot')
+    chk.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     _chain_options(chk)
     chk.set_defaults(func=cmd_check)
     urdf = sub.add_parser('urdf', help='write a robot as URDF (inertials, '
                                        'limits, a fixed tool0 link)')
-    urdf.add_argument('robot')
+    urdf.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
     urdf.add_argument('-o', '--output', metavar='FILE',
                       help='write to FILE instead of standard output')
     _chain_options(urdf)
     urdf.set_defaults(func=cmd_urdf)
     sim = sub.add_parser('simulate', help='simulate a scene offline')
-    sim.add_argument('scene', help='scene YAML file or bundled scene name')
+    sim.add_argument('scene', metavar='SCENE',
+                     help='scene YAML file or bundled scene name')
     sim.add_argument('--duration', type=float, metavar='T',
                      help="simulated seconds (default: the scene's)")
     sim.add_argument('--json', action='store_true',
@@ -405,10 +415,11 @@ def build_parser():
     sim.set_defaults(func=cmd_simulate)
     ff = sub.add_parser('feedforward', help='fill the effort of every point '
                                             'of a joint trajectory')
-    ff.add_argument('robot')
-    ff.add_argument('trajectory', help='JSON: {"joint_names": [...], '
-                                       '"points": [{"time_from_start": t, '
-                                       '"positions": [...], ...}]}')
+    ff.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    ff.add_argument('trajectory', metavar='TRAJECTORY.json',
+                    help='JSON: {"joint_names": [...], "points": '
+                         '[{"time_from_start": t, "positions": [...], '
+                         '...}]}')
     ff.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
                                                   'NY', 'NZ'),
                     help='wrench the end effector exerts along the whole '
@@ -435,14 +446,14 @@ def main(argv=None):
             parser.print_help()
             return EXIT_USAGE
         return args.func(args)
-    except (CliError, RosCliError) as exc:
+    except RosGraphError as exc:
         print(f'newton-euler: error: {exc}', file=sys.stderr)
-        return EXIT_USAGE
-    except NewtonEulerError as exc:
+        return EXIT_FAILED
+    except (CliError, RosCliError, NewtonEulerError) as exc:
         print(f'newton-euler: error: {exc}', file=sys.stderr)
-        return EXIT_ERROR
+        return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        return 130
+        return EXIT_INTERRUPTED
 
 
 if __name__ == '__main__':

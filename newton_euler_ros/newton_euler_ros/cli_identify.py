@@ -31,6 +31,7 @@ commands, never by the nodes.
 """
 import os
 import sys
+import textwrap
 import time
 
 import numpy as np
@@ -61,8 +62,10 @@ def register(subparsers):
     rep = subparsers.add_parser(
         'replay', help="the model's torques along a recording, against the "
                        'measured efforts (CSV, plot)')
-    rep.add_argument('model', metavar='MODEL.urdf')
-    rep.add_argument('bag', metavar='BAG')
+    rep.add_argument('model', metavar='MODEL.urdf',
+                     help='the URDF whose torques are replayed')
+    rep.add_argument('bag', metavar='BAG', help='rosbag2 directory (MCAP or '
+                                                'sqlite3)')
     _common(rep)
     rep.add_argument('--csv', metavar='OUT.csv', required=True,
                      help='one row per JointState message: time, then '
@@ -294,6 +297,13 @@ def cmd_replay(args):
            [('RMS raw', rms, '{:.4g}'), ('rel % raw', rel * 100, '{:.2f}'),
             (f'RMS {prep.cutoff:g} Hz', rms_l, '{:.4g}'),
             (f'rel % {prep.cutoff:g} Hz', rel_l * 100, '{:.2f}')])
+    print(textwrap.fill(
+        f'(the {prep.cutoff:g} Hz columns compare with the effort '
+        f'low-passed like the state: free of noise, but smoothed where a '
+        f"joint reverses, while the model's friction still switches "
+        f'sharply there, so on a joint with friction and little noise '
+        f'they can exceed the raw ones; docs/identification.md)', 78,
+        initial_indent='  ', subsequent_indent='   '))
     print(f'wrote {args.csv}')
     if args.plot:
         _plot(args.plot, (ns - ns[0]) * 1e-9, names, meas, mod, low)

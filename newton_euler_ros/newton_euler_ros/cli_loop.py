@@ -45,7 +45,8 @@ def register(subparsers):
         'excite', help='write an excitation trajectory (Fourier series '
                        'optimised for identification) as JointTrajectory '
                        'JSON')
-    exc.add_argument('model', metavar='MODEL.urdf')
+    exc.add_argument('model', metavar='MODEL.urdf',
+                     help='the URDF whose limits the trajectory keeps')
     exc.add_argument('--base', metavar='LINK', required=True,
                      help='first link of the chain')
     exc.add_argument('--tip', metavar='LINK', required=True,

@@ -49,10 +49,11 @@ def register(subparsers):
     obs = subparsers.add_parser(
         'observe', help='run the momentum observer (external torque, '
                         'wrench, contact) over a recorded bag')
-    obs.add_argument('robot', help='URDF (or robot YAML) file, or bundled '
-                                   'robot name')
-    obs.add_argument('bag', help='rosbag2 directory (MCAP or sqlite3) with '
-                                 'sensor_msgs/JointState')
+    obs.add_argument('robot', metavar='ROBOT',
+                     help='URDF (or robot YAML) file, or bundled robot name')
+    obs.add_argument('bag', metavar='BAG',
+                     help='rosbag2 directory (MCAP or sqlite3) with '
+                          'sensor_msgs/JointState')
     obs.add_argument('--base', metavar='LINK',
                      help='URDF only: first link of the chain (default: '
                           'the root link)')

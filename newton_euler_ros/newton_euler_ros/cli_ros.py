@@ -68,7 +68,11 @@ SYNC_S = 0.5          # record: what is recorded is on the disk this often
 
 
 class RosCliError(Exception):
-    """A bad input or a graph that cannot serve: one line, exit status 2."""
+    """A bad input: one line, exit status 2."""
+
+
+class RosGraphError(RosCliError):
+    """The ROS graph did not answer in time: one line, exit status 1."""
 
 
 def register(subparsers):
@@ -76,7 +80,8 @@ def register(subparsers):
     snd = subparsers.add_parser(
         'send', help='publish a JointTrajectory JSON file once (to the '
                      "node's ~/trajectory_in or a controller)")
-    snd.add_argument('trajectory', help='JointTrajectory JSON file')
+    snd.add_argument('trajectory', metavar='TRAJECTORY.json',
+                     help='JointTrajectory JSON file')
     snd.add_argument('--topic', default='/inverse_dynamics_node/'
                      'trajectory_in', help='where to publish (default: '
                      '%(default)s)')
@@ -106,8 +111,8 @@ def register(subparsers):
     snd.set_defaults(func=cmd_send)
     rec = subparsers.add_parser(
         'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
-    rec.add_argument('bag', help='rosbag2 directory to create (must not '
-                                 'exist)')
+    rec.add_argument('bag', metavar='BAG',
+                     help='rosbag2 directory to create (must not exist)')
     rec.add_argument('--topic', default='/joint_states',
                      help='JointState topic (default: %(default)s)')
     rec.add_argument('--duration', type=float, metavar='S',
@@ -327,7 +332,7 @@ class _Sender:
         if not ros.spin_until(lambda: self.pub.get_subscription_count() > 0,
                               args.wait):
             if not ros.stop:
-                raise RosCliError(
+                raise RosGraphError(
                     f'no subscriber on {args.topic} after {args.wait:g} s '
                     f'(is the node or the controller running, in this '
                     f'ROS_DOMAIN_ID?)')
@@ -338,7 +343,7 @@ class _Sender:
             if not ros.stop:
                 missing = [n for n in self.state.names
                            if n not in self.state.latest]
-                raise RosCliError(
+                raise RosGraphError(
                     f'no position of {", ".join(missing[:6])} on '
                     f'{args.joint_states} after {args.wait:g} s (is the '
                     f'robot driver running? --joint-states names the '
@@ -381,7 +386,7 @@ def _check_send_args(args):
 
 
 def _at_start(sender, names, goal, tol):
-    """Return True if at the start; else move or refuse (RosCliError)."""
+    """Return True if at the start; else move or refuse (RosGraphError)."""
     args = sender.args
     off = sender.offsets(names, goal)
     worst = max(abs(d) for d in off)
@@ -390,7 +395,7 @@ def _at_start(sender, names, goal, tol):
               f'offset {worst:.4f}, tolerance {tol:g})', flush=True)
         return True
     if not args.move_to_start:
-        raise RosCliError(
+        raise RosGraphError(
             f"the robot is not at the trajectory's first point (tolerance "
             f'{tol:g}; robot - start: {_off_text(names, off)}): move it '
             f'there, or add --move-to-start')
@@ -406,7 +411,7 @@ def _at_start(sender, names, goal, tol):
         if sender.ros.stop:
             return False
         off = sender.offsets(names, goal)
-        raise RosCliError(
+        raise RosGraphError(
             f"the robot did not reach the trajectory's first point within "
             f'{args.wait:g} s of the move (tolerance {tol:g}; robot - '
             f'start: {_off_text(names, off)}); nothing else sent')
@@ -521,9 +526,9 @@ def cmd_record(args):
                               args.wait):
             if ros.stop:
                 return 130
-            raise RosCliError(f'no publisher on {topic} after '
-                              f'{args.wait:g} s (is the robot driver '
-                              f'running, in this ROS_DOMAIN_ID?)')
+            raise RosGraphError(f'no publisher on {topic} after '
+                                f'{args.wait:g} s (is the robot driver '
+                                f'running, in this ROS_DOMAIN_ID?)')
         types, best_effort = _publishers(ros, topic)
         if types != {JOINT_STATE}:
             raise RosCliError(f'{topic} carries {", ".join(sorted(types))}, '

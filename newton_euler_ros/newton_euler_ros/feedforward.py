@@ -29,6 +29,7 @@ this module; everything here is testable without a ROS graph:
 Every rejection raises :class:`InputRejected` with a one-line reason and a
 short ``kind`` used for counters.
 """
+import dataclasses
 import math
 
 import numpy as np
@@ -36,7 +37,7 @@ import numpy as np
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
                    inverse_dynamics, mass_matrix)
 from .core.drives import model_drives
-from .core.effects import EffectDynamics
+from .core.effects import EffectDynamics, RIGID_BODY
 from .core.inertia import format_moments, inertia_matrix, principal_moments
 from .core.model import with_payload
 from .core.text import clip
@@ -87,15 +88,25 @@ class JointOrder:
         self.to_output = np.array([index[j] for j in output], dtype=np.intp)
         self._cache_names = None
         self._cache_take = None
+        #: the last name list that held none of the model's joints
+        self._other_names = None
 
     @property
     def n(self):
         return len(self.model_joints)
 
     def _take(self, names):
-        """Return the indices into a message's arrays that give the model's order."""
+        """
+        Return the indices into a message's arrays that give the model's order.
+
+        A message that names none of the model's joints (another
+        publisher's on the same topic, e.g. a gripper driver's) raises
+        InputRejected of kind ``other_joints``.
+        """
         if names == self._cache_names:
             return self._cache_take
+        if names == self._other_names:
+            raise self._other_joints(names)
         where = {}
         for i, name in enumerate(names):
             if not name.isprintable():
@@ -108,17 +119,24 @@ class JointOrder:
                                     f'twice')
             where[name] = i
         missing = [j for j in self.model_joints if j not in where]
+        if names and len(missing) == len(self.model_joints):
+            self._other_names = list(names)
+            raise self._other_joints(names)
         if missing:
-            known = set(self.model_joints)
-            unknown = [clip(x, 60) for x in names if x not in known][:5]
+            # all of them, and what the message does name
             raise InputRejected(
-                'missing_joints', f'missing joints {missing}'
-                + (f'; not joints of the robot: {unknown}' if unknown
-                   else ''))
+                'missing_joints', f'missing joints {clip(missing, 600)}; '
+                f'the message names {len(names)}: '
+                f'{clip([clip(x, 60) for x in names], 600)}')
         take = np.array([where[j] for j in self.model_joints], dtype=np.intp)
         self._cache_names = list(names)
         self._cache_take = take
         return take
+
+    def _other_joints(self, names):
+        return InputRejected(
+            'other_joints', f"none of the robot's joints (it names "
+            f'{clip([clip(x, 60) for x in names[:8]], 300)})')
 
     def gather(self, names, field, values, required=True):
         """
@@ -394,7 +412,8 @@ class FeedforwardComputer:
     def __init__(self, model, order, wrench_input, reference=None,
                  scene=None, mode=None, *, guard=None, bound_sources=None,
                  velocity_bounds=None, max_future=1.0, max_age=0.0,
-                 bare_model=None, bare_scene=None):
+                 bare_model=None, bare_scene=None,
+                 robot_compensates_gravity=False):
         self.mode = mode or ('full' if reference is not None
                              else 'gravity_coriolis')
         if self.mode not in MODES:
@@ -404,10 +423,18 @@ class FeedforwardComputer:
         if model is None:
             model = scene.model
         # the live torques: exactly the scene's effects, or every
-        # rigid-body term and the wrench without a scene
-        self.dyn = (EffectDynamics(model, scene.effects, scene.viscous,
+        # rigid-body term and the wrench without a scene; without gravity
+        # when the robot adds it itself
+        effects = scene.effects if scene is not None else RIGID_BODY
+        #: g(q) in the world (reported by the service's gravity field)
+        self.has_gravity = effects.gravity
+        #: the robot adds g(q) itself: no torque published holds it
+        self.robot_compensates_gravity = bool(robot_compensates_gravity)
+        if self.robot_compensates_gravity:
+            effects = dataclasses.replace(effects, gravity=False)
+        self.dyn = (EffectDynamics(model, effects, scene.viscous,
                                    scene.coulomb, scene.armature)
-                    if scene is not None else EffectDynamics(model))
+                    if scene is not None else EffectDynamics(model, effects))
         self.model = self.dyn.model
         self.order = order
         self.wrench = wrench_input
@@ -438,8 +465,9 @@ class FeedforwardComputer:
 
         ``params`` maps parameter names to values (``limits.action``,
         ``limits.velocity_factor``, ``limits.max_velocity``,
-        ``joint_states.max_future``, ``joint_states.max_age``, and
-        ``drives.compensate`` to add the model's drive terms); ``bounds``
+        ``joint_states.max_future``, ``joint_states.max_age``,
+        ``drives.compensate`` to add the model's drive terms and
+        ``robot_compensates_gravity`` to leave g(q) out); ``bounds``
         and ``bound_sources`` are the torque bounds in model order and
         where each comes from (``safety.effort_bounds``).  The kernels are
         compiled or loaded before it returns (:meth:`warm_up`).
@@ -453,7 +481,9 @@ class FeedforwardComputer:
                      params['limits.max_velocity']),
                  max_future=params['joint_states.max_future'],
                  max_age=params['joint_states.max_age'],
-                 bare_model=bare_model, bare_scene=bare_scene)
+                 bare_model=bare_model, bare_scene=bare_scene,
+                 robot_compensates_gravity=params.get(
+                     'robot_compensates_gravity', False))
         if params.get('drives.compensate'):
             ff.drives = model_drives(model if bare_model is None
                                      else bare_model)
@@ -560,10 +590,11 @@ class FeedforwardComputer:
         D = self.dyn.mass_matrix(q)
         C = coriolis_matrix(self.model, q, qd, ws=self.ws)
         g = gravity_torques(self.model, q, ws=self.ws)
-        eff = self.dyn.effects          # the terms the scene has
-        if not eff.velocity_products:
+        # the terms the scene has (g is reported even when the robot
+        # adds it itself; tau then leaves it out)
+        if not self.dyn.effects.velocity_products:
             C[:] = 0.0
-        if not eff.gravity:
+        if not self.has_gravity:
             g[:] = 0.0
         tau = self._torques(q, qd, qdd, w, frame)
         o = self.order

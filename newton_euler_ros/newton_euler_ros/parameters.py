@@ -39,6 +39,10 @@ import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 NODES = ('inverse_dynamics_node', 'robot_sim_node', 'tracking_controller_node')
+#: each node's reference page (topics, parameters), in the repository
+NODE_PAGES = {'inverse_dynamics_node': 'docs/node.md',
+              'robot_sim_node': 'docs/scenes-and-demos.md',
+              'tracking_controller_node': 'docs/scenes-and-demos.md'}
 
 
 def schema_path(node_name):
@@ -199,9 +203,15 @@ def node_help(node_name):
         doc = ast.get_docstring(ast.parse(fh.read())) or node_name
     lines = [f'usage: {node_name} [-h] [--ros-args [-p NAME:=VALUE]... '
              f'[--params-file FILE]... [-r FROM:=TO]...]', '', doc, '',
-             'Parameters (-p NAME:=VALUE, or --params-file FILE with a',
-             f'section {node_name}: or /**:; an unknown name stops the '
-             f'node):']
+             f'Reference: {NODE_PAGES[node_name]} in the newton_euler_ros '
+             f'repository.', '',
+             *textwrap.wrap(
+                 f'Parameters (-p NAME:=VALUE, or --params-file FILE with '
+                 f'a section {node_name}: or /**:; an unknown name stops '
+                 f"the node; ROS 2's own are accepted: use_sim_time, "
+                 f'start_type_description_service and qos_overrides.TOPIC.'
+                 f"publisher|subscription.POLICY, applied to the node's "
+                 f'topics):', 78)]
     for spec in load_specs(node_name):
         flags = ', read-only' if spec.read_only else ''
         lines.append(f'  {spec.name} ({spec.type}, default '

@@ -34,6 +34,18 @@ The torque a joint's drive needs on top of the rigid-body torque::
           <ne:drive armature="0.12" offset="-0.05" coulomb_width="0.02"/>
         </joint>
 
+- ``torque_constant`` K (N m, or N, per effort unit): for a robot whose
+  ``JointState.effort`` is not a torque (UR's driver reports motor current
+  in A by default), the joint torque is K times the effort.  Also an
+  attribute of ``<ne:drive>``; absent on every joint when the efforts are
+  torques (``Drives.torque_constant`` is then None).  Every term above is
+  a joint torque, in N m, whatever the effort's unit.
+
+Only the ``<joint>`` elements that are children of ``<robot>`` are read:
+a ros2_control description also has ``<joint name=...>`` elements inside
+``<ros2_control>`` and ``<transmission>`` blocks, which are not joints of
+the kinematic tree.
+
 Coulomb friction near rest.  sign(qd) jumps at qd = 0, where a real joint
 sticks with any friction torque between -F_c and F_c.  The smooth sign
 tanh(qd / eps) is 0 at rest, 76 % of F_c at |qd| = eps and within 0.01 %
@@ -43,7 +55,6 @@ chatter the feedforward, and its full value from a few eps on.
 """
 from dataclasses import dataclass
 import math
-import xml.etree.ElementTree as ET
 
 import numpy as np
 
@@ -64,23 +75,47 @@ class Drives:
     offset: np.ndarray
     armature: np.ndarray
     coulomb_width: np.ndarray
+    torque_constant: np.ndarray = None
 
     @classmethod
-    def zeros(cls, n, coulomb_width=DEFAULT_COULOMB_WIDTH):
+    def zeros(cls, n, coulomb_width=DEFAULT_COULOMB_WIDTH,
+              torque_constant=None):
         """Return drives that add nothing."""
         z = np.zeros(n)
         return cls(z, z.copy(), z.copy(), z.copy(),
-                   np.full(n, float(coulomb_width)))
+                   np.full(n, float(coulomb_width)),
+                   _constants(torque_constant, n))
 
     @classmethod
-    def from_parameters(cls, p, coulomb_width=DEFAULT_COULOMB_WIDTH):
+    def from_parameters(cls, p, coulomb_width=DEFAULT_COULOMB_WIDTH,
+                        torque_constant=None):
         """From the 4n drive parameters in the regressor's order."""
         p = np.asarray(p, dtype=np.float64).reshape(-1, 4)
         n = p.shape[0]
         width = np.broadcast_to(np.asarray(coulomb_width, dtype=float),
                                 (n,)).copy()
         return cls(p[:, 0].copy(), p[:, 1].copy(), p[:, 2].copy(),
-                   p[:, 3].copy(), width)
+                   p[:, 3].copy(), width, _constants(torque_constant, n))
+
+    def with_torque_constant(self, torque_constant):
+        """Return a copy with these torque constants (None: torques)."""
+        return Drives(self.viscous, self.coulomb, self.offset,
+                      self.armature, self.coulomb_width,
+                      _constants(torque_constant, self.n))
+
+    def effort_to_torque(self, effort):
+        """Joint torques of (..., n) efforts: K effort (as is without K)."""
+        effort = np.asarray(effort, dtype=np.float64)
+        if self.torque_constant is None:
+            return effort
+        return effort * self.torque_constant
+
+    def torque_to_effort(self, tau):
+        """Efforts of (..., n) joint torques: tau / K (as is without K)."""
+        tau = np.asarray(tau, dtype=np.float64)
+        if self.torque_constant is None:
+            return tau
+        return tau / self.torque_constant
 
     @property
     def n(self):
@@ -106,6 +141,16 @@ class Drives:
             out[...] = tau
             return out
         return tau
+
+
+def _constants(k, n):
+    if k is None:
+        return None
+    k = np.broadcast_to(np.asarray(k, dtype=np.float64), (n,)).copy()
+    if not np.all(np.isfinite(k)) or not np.all(k > 0):
+        raise ValueError(f'torque constants must be finite and > 0, got '
+                         f'{k.tolist()}')
+    return k
 
 
 def model_drives(model):
@@ -139,10 +184,11 @@ def read_drives(root, joint_names, label='robot_description'):
     ``<ne:drive>``; raises RobotFileError on a bad value (one line naming
     the joint and the attribute).
     """
-    joints = {el.get('name'): el for el in root.iter('joint')}
+    joints = {el.get('name'): el for el in root.findall('joint')}
     n = len(joint_names)
     vals = {k: np.zeros(n) for k in FIELDS}
     width = np.full(n, DEFAULT_COULOMB_WIDTH)
+    constant = np.full(n, np.nan)
     found = False
     for j, name in enumerate(joint_names):
         el = joints.get(name)
@@ -172,12 +218,30 @@ def read_drives(root, joint_names, label='robot_description'):
                         f'{label}: {where} coulomb_width: must be > 0, got '
                         f'{v:g}')
                 width[j] = v
+            v = _number(ext, 'torque_constant', where, label)
+            if v is not None:
+                if not v > 0:
+                    raise RobotFileError(
+                        f'{label}: {where} torque_constant: must be > 0 (N m '
+                        f'per effort unit), got {v:g}')
+                constant[j] = v
+                found = True
     if not found:
         return None
     return Drives(vals['viscous'], vals['coulomb'], vals['offset'],
-                  vals['armature'], width)
+                  vals['armature'], width,
+                  _all_or_none(constant, joint_names, label))
 
 
-def read_drives_text(text, joint_names, label='robot_description'):
-    """:func:`read_drives` from URDF text."""
-    return read_drives(ET.fromstring(text), joint_names, label)
+def _all_or_none(constant, joint_names, label):
+    given = np.isfinite(constant)
+    if not given.any():
+        return None
+    if not given.all():
+        missing = [name for name, k in zip(joint_names, given) if not k]
+        raise RobotFileError(
+            f'{label}: <{DRIVES_PREFIX}:drive> torque_constant is given for '
+            f'some joints but not for {", ".join(map(repr, missing))}: give '
+            f'it for every joint of the chain (the efforts of one robot '
+            f'share a unit)')
+    return constant

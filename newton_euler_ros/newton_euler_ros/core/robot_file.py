@@ -374,16 +374,35 @@ def singular_joint_warning(model, origin, samples=3, seed=0):
 
 
 def is_urdf(name_or_path):
-    """Return True for a path that names a URDF file (``.urdf``)."""
-    return str(name_or_path).lower().endswith('.urdf')
+    """
+    Return True for a path that names a URDF file.
+
+    A ``.urdf`` path, or a file of any other name whose text starts with
+    ``<`` (XML, which a robot YAML file never is): a URDF saved as
+    ``.xml``, or a xacro file, which the URDF reader then refuses in one
+    line.
+    """
+    path = os.fspath(name_or_path)
+    if path.lower().endswith('.urdf'):
+        return True
+    if not os.path.isfile(path):
+        return False
+    try:
+        with open(path, 'rb') as fh:
+            head = fh.read(4096)
+    except OSError:
+        return False            # the YAML reader says why
+    return head.decode('utf-8', 'ignore').lstrip('\ufeff \t\r\n') \
+        .startswith('<')
 
 
 def inspect_robot(name_or_path, base=None, tip=None):
     """
     Load and validate a robot; return (model, warnings, path).
 
-    A ``.urdf`` path is read by :func:`~newton_euler_ros.core.urdf.inspect_urdf`
-    with its ``base`` and ``tip`` links (what it made of the tree is in
+    A URDF file (:func:`is_urdf`: ``.urdf``, or XML under another name)
+    is read by :func:`~newton_euler_ros.core.urdf.inspect_urdf` with its
+    ``base`` and ``tip`` links (what it made of the tree is in
     ``model.info['urdf']``); anything else is a robot YAML file or a
     bundled name, for which ``base`` and ``tip`` must be None.
     """
@@ -393,7 +412,7 @@ def inspect_robot(name_or_path, base=None, tip=None):
     else:
         if base is not None or tip is not None:
             raise RobotFileError(f'{name_or_path}: base and tip links apply '
-                                 f'to URDF robots (.urdf files) only')
+                                 f'to URDF robots only')
         path = resolve_robot_path(name_or_path)
         data = read_yaml(path)
         model, found = robot_from_dict(data, os.path.basename(path))

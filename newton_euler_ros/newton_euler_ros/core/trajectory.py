@@ -221,20 +221,23 @@ def trajectory_arrays(model, joint_names, points, where=''):
 
 
 def trajectory_efforts(model, joint_names, points, wrench=None,
-                       wrench_frame='base', where='', ws=None, drives=None):
+                       wrench_frame='base', where='', ws=None, drives=None,
+                       gravity=True):
     """
     Efforts (m, n) at every point, in the trajectory's joint order.
 
     tau = D qdd + C qd + g (+ J^T F_e for a ``wrench`` held along the whole
-    trajectory, + the drive terms of ``drives``, a ``core.drives.Drives``),
-    one batched call; raises :class:`TrajectoryError` for a bad trajectory
+    trajectory, + the drive terms of ``drives``, a ``core.drives.Drives``;
+    without g when not ``gravity``: a robot that adds it itself), one
+    batched call; raises :class:`TrajectoryError` for a bad trajectory
     (one line naming the point and the field).
     """
     _, Q, QD, QDD = trajectory_arrays(model, joint_names, points, where)
     W = None
     if wrench is not None:
         W = np.tile(np.asarray(wrench, dtype=np.float64), (Q.shape[0], 1))
-    tau = inverse_dynamics_batch(model, Q, QD, QDD, W, wrench_frame, ws=ws)
+    tau = inverse_dynamics_batch(model, Q, QD, QDD, W, wrench_frame,
+                                 gravity=gravity, ws=ws)
     if drives is not None:
         tau = tau + drives.torques(QD, QDD)
     cols = _column_map(model, joint_names, where)

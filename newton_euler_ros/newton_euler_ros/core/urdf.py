@@ -28,8 +28,10 @@ What a URDF model means here (see the README, "Robots from URDF"):
   by the parallel-axis theorem (``inertia.merge_bodies``).
 - Off-chain subtrees (gripper fingers, a second arm, a head) are lumped
   rigidly into the chain link they hang from, at their joints' zero
-  position (a ``mimic`` joint at its offset), with one warning naming
-  them: their own motion is not modelled.
+  position (a ``mimic`` joint at its offset).  A fixed joint off the chain
+  (a hand, a camera, a flange frame) is merged like one on it, without a
+  word; the moving joints so locked are named in one warning: their own
+  motion is not modelled.
 - ``<inertial>`` with its ``<origin xyz rpy>``: the inertia is rotated into
   the link frame (I_link = R I R^T, the centre of mass at xyz).  A link
   without ``<inertial>`` is massless (one warning lists them; not for
@@ -126,19 +128,34 @@ def _parse(text, src):
         line, col = getattr(exc, 'position', (0, 0))
         raise RobotFileError(f'{src.label}: not well-formed XML (line '
                              f'{line}, column {col + 1})') from None
+    sign = _xacro_sign(root)
+    if sign:
+        raise RobotFileError(f'{src.label}: xacro, not URDF ({sign}): '
+                             f'expand it with xacro first')
     if root.tag != 'robot':
-        if root.tag.startswith('{') and 'xacro' in root.tag:
-            raise RobotFileError(f'{src.label}: a xacro file: expand it '
-                                 f'with xacro first')
         raise RobotFileError(f'{src.label}: the root element is '
                              f'<{_short(root.tag)}>, not <robot>')
-    for el in root.iter():
-        if isinstance(el.tag, str) and el.tag.startswith('{') \
-                and 'xacro' in el.tag:
-            raise RobotFileError(
-                f'{src.label}: contains xacro elements '
-                f'(<{_short(el.tag)}>): expand it with xacro first')
     return root
+
+
+def _xacro_sign(root):
+    """
+    Return what shows a document is xacro, or '' for plain XML.
+
+    An element in the xacro namespace (``<xacro:macro>``), or an
+    attribute holding a xacro expression (``${...}``) or substitution
+    (``$(find ...)``).  The ``xmlns:xacro`` declaration alone is not a
+    sign: xacro leaves it in the URDF it writes.
+    """
+    for el in root.iter():
+        tag = el.tag if isinstance(el.tag, str) else ''
+        if tag.startswith('{') and 'xacro' in tag.partition('}')[0]:
+            return f'<xacro:{_short(tag.partition("}")[2], 60)}>'
+        for attr, value in el.attrib.items():
+            if '${' in value or '$(' in value:
+                return (f'<{_short(tag, 60)} {_short(attr, 60)}='
+                        f'"{_short(value, 60)}">')
+    return ''
 
 
 def _numbers(el, attr, count, where, src, default=None):
@@ -413,6 +430,7 @@ class _Bodies:
     def __init__(self, links, joints, base, chain, moving):
         self.mass, self.com, self.inertia, self.carried = [], [], [], []
         self.lumped = []        # (joint, kind) of off-chain subtrees
+        self.locked = []        # off-chain moving joints, at any depth
         self.massless = []      # links without <inertial>
         chain_links = {base} | {joints[j].child for j in chain}
         for k, jname in enumerate(moving):
@@ -430,9 +448,11 @@ class _Bodies:
                 if not links[lname].has_inertial and not (
                         joint is not None and joint.kind == 'fixed'):
                     self.massless.append(lname)
-                if joint is not None and via not in chain \
-                        and joint.parent in chain_links:
-                    self.lumped.append((via, joint.kind))
+                if joint is not None and via not in chain:
+                    if joint.parent in chain_links:
+                        self.lumped.append((via, joint.kind))
+                    if joint.kind != 'fixed':
+                        self.locked.append(via)
 
 
 def _attached_frames(links, joints, base, moving, tip_parts, tool):
@@ -455,21 +475,25 @@ def _attached_frames(links, joints, base, moving, tip_parts, tool):
     return tip_frames, base_frames
 
 
+def _locked_text(joint):
+    if joint.mimic:
+        other, mult, off = joint.mimic
+        return (f'{joint.name} ({joint.kind}, mimic of {other}, at '
+                f'{off:g})')
+    return f'{joint.name} ({joint.kind})'
+
+
 def _tree_warnings(label, links, joints, bodies):
-    """Return what the user should know of the tree: lumped, massless, odd."""
+    """Return what the user should know of the tree: locked, massless, odd."""
     found = []
-    # massless frames on fixed joints (ee_link, tool0) change nothing
-    told = [(v, kind) for v, kind in bodies.lumped if kind != 'fixed'
-            or links[joints[v].child].mass > 0.0
-            or links[joints[v].child].inertia.any()]
-    if told:
-        moved = [f'{v} ({kind})' for v, kind in told if kind != 'fixed']
+    # fixed joints off the chain (a hand, a camera, ee_link) are merged as
+    # those on it are: a correct model; moving ones are locked
+    if bodies.locked:
         found.append(
-            f'{label}: off-chain subtrees lumped rigidly into the chain at '
-            f'their zero position (their motion is not modelled): joints '
-            f'{_short(", ".join(v for v, _ in told), 400)}'
-            + (f'; moving ones locked: {_short(", ".join(moved), 300)}'
-               if moved else ''))
+            f'{label}: moving joints off the chain locked at zero (their '
+            f'motion is not modelled; their links are lumped rigidly into '
+            f'the chain): ' + _short(', '.join(
+                _locked_text(joints[j]) for j in bodies.locked), 400))
     if bodies.massless:
         found.append(f'{label}: links without <inertial> are massless: '
                      f'{_short(", ".join(sorted(set(bodies.massless))), 400)}')
@@ -511,6 +535,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         'chain_links': [joints[j].child for j in chain],
         'links': [joints[j].child for j in moving],
         'merged_fixed': merged, 'lumped': [v for v, _ in bodies.lumped],
+        'locked': list(bodies.locked),
         'tip_frames': tip_frames, 'base_frames': base_frames,
         'continuous': [j for j in moving if joints[j].kind == 'continuous'],
     }

@@ -55,6 +55,7 @@ import sys
 import numpy as np
 
 from ..core.errors import NewtonEulerError
+from ..core.text import clip
 
 DEFAULT_TOPIC = '/joint_states'
 JOINT_STATE = 'sensor_msgs/msg/JointState'
@@ -281,6 +282,11 @@ class _Selector:
             self.cache[key] = idx
         return idx
 
+    def names_seen(self):
+        """Every joint name the messages had, in order of appearance."""
+        return list(dict.fromkeys(n if n.isprintable() else repr(n)
+                                  for key in self.cache for n in key))
+
 
 def _pick(values, idx):
     if len(values) == 0:
@@ -422,7 +428,8 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
         sample = samples.take(logtime, msg)
         if sample is not None and buf.add(*sample):
             yield buf.take(samples.have_qd, joint_names, counts, notes)
-    _check_totals(label, topic, counts, samples.missing_seen, min_samples)
+    _check_totals(label, topic, counts, samples.missing_seen, min_samples,
+                  samples.select.names_seen())
     if buf.k:
         yield buf.take(samples.have_qd, joint_names, counts, notes)
 
@@ -452,13 +459,17 @@ def _same(a, b):
     return True
 
 
-def _check_totals(label, topic, counts, missing_seen, min_samples):
+def _check_totals(label, topic, counts, missing_seen, min_samples,
+                  names_seen=()):
     if counts['kept'] >= min_samples:
         return
     if counts['kept'] == 0 and counts['missing_joint'] and missing_seen:
-        shown = ', '.join(missing_seen[:4])
-        raise BagError(f'{label}: chain joint(s) {shown} not in the '
-                       f'JointState messages on {topic!r}')
+        # every missing joint, and the names the messages do have
+        raise BagError(
+            f'{label}: chain joint(s) {clip(", ".join(missing_seen), 600)} '
+            f'not in the JointState messages on {topic!r}; they name '
+            f'{len(names_seen)} joint(s): '
+            f'{clip(", ".join(names_seen), 600) or "none"}')
     if counts['kept'] == 0 and counts['no_effort']:
         raise BagError(f'{label}: the JointState messages on {topic!r} '
                        'have no effort field (efforts are needed to '

@@ -158,6 +158,8 @@ def _set_drive(joint_el, drives, j):
     ext.set('armature', repr(float(drives.armature[j])))
     ext.set('offset', repr(float(drives.offset[j])))
     ext.set('coulomb_width', repr(float(drives.coulomb_width[j])))
+    if drives.torque_constant is not None:
+        ext.set('torque_constant', repr(float(drives.torque_constant[j])))
 
 
 def identified_urdf(text, model, theta, fixed, drives):

@@ -24,6 +24,14 @@ A parameter override (``-p`` or a params file) that no declared
 parameter matches is a ConfigurationError too, naming the closest real
 parameter; a ``--params-file`` with no section for the node's name gets a
 warning naming the sections it has (its parameters then do not apply).
+The parameters ROS 2 itself gives every node are not the node's to
+refuse: ``use_sim_time`` and ``start_type_description_service`` (rclpy
+declares them) and ``qos_overrides.<topic>.<publisher|subscription>.
+<policy>``, which a robot bringup's shared ``/**:`` file sets for the
+topics of every node.  :class:`SharedGraphNode` applies the QoS overrides
+to the node's own publishers and subscriptions (history, depth,
+reliability, durability; read-only, as in rclcpp) and ignores those
+meant for other nodes' topics.
 
 ``run_node`` is the Jazzy-style main: init, build the node (a
 configuration error refuses to start with a one-line reason and exit
@@ -46,6 +54,7 @@ import os
 import re
 import signal
 import sys
+import warnings
 
 from rcl_interfaces.msg import ParameterDescriptor
 import rclpy
@@ -53,8 +62,12 @@ from rclpy.event_handler import PublisherEventCallbacks
 from rclpy.exceptions import ParameterException
 from rclpy.executors import ExternalShutdownException, \
     SingleThreadedExecutor
+from rclpy.node import Node
 from rclpy.parameter import Parameter
-from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rclpy.qos import HistoryPolicy, QoSPolicyKind, QoSProfile, \
+    ReliabilityPolicy
+from rclpy.qos_overriding_options import InvalidQosOverridesError, \
+    QoSOverridingOptions
 from rclpy.signals import SignalHandlerOptions
 
 from ..parameters import help_requested, print_help, validate
@@ -198,20 +211,107 @@ def _warn_foreign_params_files(node):
                 f'/**:)')
 
 
+#: parameters rclpy declares on every node (its clock, its type
+#: description service): a shared params file may set them for all nodes
+RCLPY_PARAMETERS = ('use_sim_time', 'start_type_description_service')
+#: prefix of ROS 2's QoS override parameters
+QOS_OVERRIDES = 'qos_overrides.'
+#: the policies a qos_overrides entry may set on the nodes' topics
+QOS_POLICIES = (QoSPolicyKind.HISTORY, QoSPolicyKind.DEPTH,
+                QoSPolicyKind.RELIABILITY, QoSPolicyKind.DURABILITY)
+
+
+def ros_parameter(name):
+    """Return True for a parameter that ROS 2 owns, not the node."""
+    return name in RCLPY_PARAMETERS or name.startswith(QOS_OVERRIDES)
+
+
+def _check_qos(qos):
+    from rcl_interfaces.msg import SetParametersResult
+    if qos.history == HistoryPolicy.KEEP_LAST and qos.depth < 1:
+        return SetParametersResult(
+            successful=False, reason=f'depth must be >= 1 with history '
+            f'keep_last, got {qos.depth}')
+    return SetParametersResult(successful=True)
+
+
+class SharedGraphNode(Node):
+    """
+    A Node whose topics take ROS 2's ``qos_overrides`` parameters.
+
+    Every publisher and subscription the node creates after its
+    construction declares ``qos_overrides.<topic>.<kind>.<policy>`` for
+    history, depth, reliability and durability (read-only), as rclcpp's
+    ``QosOverridingOptions`` does: a value from a params file replaces the
+    node's own QoS for that topic.  A bad value (``reliability: sure``,
+    ``depth: 0``) is a ConfigurationError naming the parameter.
+    """
+
+    def __init__(self, node_name, **kwargs):
+        super().__init__(node_name, **kwargs)
+        # not for what Node.__init__ creates (/parameter_events)
+        self._qos_overridable = True
+
+    def create_publisher(self, msg_type, topic, qos_profile, **kwargs):
+        """Create a publisher whose QoS a qos_overrides entry can set."""
+        return self._overridable(super().create_publisher, 'publisher',
+                                 topic, (msg_type, topic, qos_profile),
+                                 kwargs)
+
+    def create_subscription(self, msg_type, topic, callback, qos_profile,
+                            **kwargs):
+        """Create a subscription whose QoS a qos_overrides entry can set."""
+        return self._overridable(super().create_subscription,
+                                 'subscription', topic,
+                                 (msg_type, topic, callback, qos_profile),
+                                 kwargs)
+
+    def _overridable(self, create, kind, topic, args, kwargs):
+        if not getattr(self, '_qos_overridable', False) or \
+                'qos_overriding_options' in kwargs:
+            return create(*args, **kwargs)
+        prefix = f'{QOS_OVERRIDES}{self.resolve_topic_name(topic)}.{kind}.'
+        given = sorted(name for name in getattr(
+            self, '_parameter_overrides', {}) if name.startswith(prefix))
+        options = QoSOverridingOptions(QOS_POLICIES, callback=_check_qos)
+        try:
+            with warnings.catch_warnings():     # depth 0: said below
+                warnings.simplefilter('ignore', UserWarning)
+                entity = create(*args, qos_overriding_options=options,
+                                **kwargs)
+        except (InvalidQosOverridesError, ParameterException,
+                RuntimeError, ValueError) as exc:
+            if not given:
+                raise
+            reason = (str(exc) or type(exc).__name__).splitlines()[0]
+            reason = reason.split('are not valid: ')[-1]
+            raise ConfigurationError(
+                f'{", ".join(given)}: {reason[:300]}') from None
+        if given:
+            values = ', '.join(
+                f'{name[len(prefix):]} {self.get_parameter(name).value}'
+                for name in given if self.has_parameter(name))
+            self.get_logger().info(
+                f'qos_overrides: {prefix[len(QOS_OVERRIDES):-1]}: {values}')
+        return entity
+
+
 def check_overrides(node, specs):
     """
     Refuse parameter overrides that no parameter of ``specs`` matches.
 
     rclpy drops an override (``-p`` or a params file) that is never
     declared without a word; raise a ConfigurationError naming it and the
-    closest real parameter instead.  Also warns about params files that
-    have no section for this node.
+    closest real parameter instead.  The parameters ROS 2 owns
+    (:func:`ros_parameter`) are not the node's to refuse.  Also warns
+    about params files that have no section for this node.
     """
     _warn_foreign_params_files(node)
     names = [spec.name for spec in specs]
     overrides = getattr(node, '_parameter_overrides', None) or {}
     unknown = [name for name in overrides
-               if name not in names and not node.has_parameter(name)]
+               if name not in names and not node.has_parameter(name)
+               and not ros_parameter(name)]
     reasons = []
     for name in sorted(unknown):
         close = difflib.get_close_matches(name, names, n=1, cutoff=0.5)

@@ -16,7 +16,7 @@
 inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
-result is published.  See the README ("ROS 2 node") for the interface.
+result is published.  docs/node.md describes the whole interface.
 
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
@@ -46,7 +46,6 @@ from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, String
@@ -54,7 +53,7 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
                      declare_parameters, plain, qos_profile, QUIET,
-                     release_memory, run_node)
+                     release_memory, run_node, SharedGraphNode)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
@@ -72,7 +71,7 @@ COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'service_calls', 'service_failures', 'internal_error',
             'no_model', 'descriptions_loaded', 'descriptions_rejected',
             'trajectories', 'payload_changes', 'implausible', 'over_limit',
-            'oversized', 'bad_stamp')
+            'oversized', 'bad_stamp', 'other_joints')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -83,7 +82,7 @@ def _seconds(stamp):
     return stamp.sec + stamp.nanosec * 1e-9
 
 
-class InverseDynamicsNode(Node):
+class InverseDynamicsNode(SharedGraphNode):
     """Feedforward torques from joint states, by Newton-Euler."""
 
     def __init__(self, **kwargs):
@@ -95,6 +94,8 @@ class InverseDynamicsNode(Node):
         self._last_log = {}
         self.ff = None          # swapped whole when a new model arrives
         self.model_source = ''
+        #: why the last robot_description was rejected ('' when it loaded)
+        self.description_rejected = ''
         scene = None
         if p['mode'] in ('gravity', 'gravity_coriolis') and \
                 p['acceleration_source'] == 'reference':
@@ -238,7 +239,10 @@ class InverseDynamicsNode(Node):
             + ('' if not self.params['drives.compensate'] else
                ', drive terms compensated' if ff.drives is not None else
                ', drives.compensate is on but the robot has no drive '
-               'terms'))
+               'terms')
+            + (', without g(q): the robot adds it '
+               '(robot_compensates_gravity)'
+               if ff.robot_compensates_gravity else ''))
 
     # ---- robot_description ----
     def _on_description(self, msg):
@@ -255,22 +259,23 @@ class InverseDynamicsNode(Node):
                 text, 'robot_description', base=p['base_link'] or None,
                 tip=p['tip_link'] or None)
             ff = self._make_computer(model)
-        except (NewtonEulerError, ValueError) as exc:
+        except Exception as exc:  # never let a description kill the node
+            reason = clip(str(exc), 400)
+            if not isinstance(exc, (NewtonEulerError, ValueError)):
+                reason = f'internal error: {reason}'
             self.counts['descriptions_rejected'] += 1
+            with self._description_lock:
+                if seq == self._description_seq:    # the newest one
+                    self.description_rejected = reason
             keep = ('the previous model keeps working' if self.ff is not None
                     else 'still no model: publishing nothing')
             self.get_logger().error(
-                f'robot_description rejected: {clip(str(exc), 400)}; {keep}')
-            return
-        except Exception as exc:  # never let a description kill the node
-            self.counts['descriptions_rejected'] += 1
-            self.get_logger().error(
-                f'robot_description rejected (internal error): '
-                f'{clip(str(exc), 400)}')
+                f'robot_description rejected: {reason}; {keep}')
             return
         with self._description_lock:
             if seq != self._description_seq:
                 return          # a newer description is on its way
+            self.description_rejected = ''
             for message in found:
                 log = (self.get_logger().debug if isinstance(message, Note)
                        else self.get_logger().warning)
@@ -371,7 +376,12 @@ class InverseDynamicsNode(Node):
                     f'{ff.wrench.timeout} s; torques no longer include '
                     f'it'))
         except InputRejected as exc:
-            self._reject('joint state', exc)
+            if exc.kind == 'other_joints':
+                # another publisher on joint_states (a gripper driver's):
+                # normal in a robot graph, counted and not logged
+                self.counts['other_joints'] += 1
+            else:
+                self._reject('joint state', exc)
             return
         except Exception as exc:  # never let a message kill the node
             self._reject('joint state', exc)
@@ -454,7 +464,9 @@ class InverseDynamicsNode(Node):
                         else (None, 'base'))
             efforts = trajectory_efforts(ff.model, msg.joint_names, points,
                                          w, frame, 'trajectory: ', ff.ws,
-                                         drives=ff.drives)
+                                         drives=ff.drives,
+                                         gravity=not
+                                         ff.robot_compensates_gravity)
         except NewtonEulerError as exc:
             self._reject('trajectory', InputRejected('malformed', str(exc)))
             return
@@ -483,8 +495,7 @@ class InverseDynamicsNode(Node):
         if ff is None:
             self.counts['service_failures'] += 1
             response.success = False
-            response.message = ('no robot model yet (waiting for '
-                                'robot_description)')
+            response.message = self._no_model_text()
             return response
         try:
             D, C, g, tau = ff.terms(
@@ -510,15 +521,31 @@ class InverseDynamicsNode(Node):
         response.torque = tau.tolist()
         return response
 
+    def _no_model_text(self):
+        """Say why there is no model: waiting, or the description rejected."""
+        rejected = self.description_rejected
+        if rejected:
+            return (f'no robot model: robot_description rejected: '
+                    f'{rejected}')
+        return 'no robot model yet (waiting for robot_description)'
+
     def _publish_counts(self):
         release_memory()
         ff = self.ff
+        rejected = self.description_rejected
+        if ff is None:
+            level, message = (
+                DiagnosticStatus.ERROR if rejected else DiagnosticStatus.WARN,
+                f'{self._no_model_text()}: publishing nothing')
+        elif rejected:
+            level, message = DiagnosticStatus.WARN, (
+                f'input counters; the last robot_description was rejected '
+                f'({rejected}); the previous model keeps working')
+        else:
+            level, message = DiagnosticStatus.OK, 'input counters'
         status = DiagnosticStatus(
-            level=DiagnosticStatus.OK if ff is not None
-            else DiagnosticStatus.WARN,
-            name=self.get_fully_qualified_name(),
-            message=('input counters' if ff is not None else
-                     'waiting for robot_description: publishing nothing'),
+            level=level, name=self.get_fully_qualified_name(),
+            message=message,
             hardware_id=ff.model.name if ff is not None else '')
         status.values = [KeyValue(key=k, value=str(v))
                          for k, v in self.counts.items()]
@@ -528,6 +555,8 @@ class InverseDynamicsNode(Node):
             hardware_id=ff.model.name if ff is not None else '')
         model.values = [
             KeyValue(key='mode', value=self.mode),
+            KeyValue(key='robot_compensates_gravity', value=str(
+                self.params['robot_compensates_gravity']).lower()),
             KeyValue(key='payload.mass', value=repr(self.payload[0])),
             KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
             KeyValue(key='payload.inertia',

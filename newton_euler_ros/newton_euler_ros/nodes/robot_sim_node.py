@@ -62,7 +62,6 @@ import time
 from geometry_msgs.msg import WrenchStamped
 import numpy as np
 from rcl_interfaces.msg import SetParametersResult
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rclpy.time import Time
 from sensor_msgs.msg import JointState
@@ -70,7 +69,8 @@ from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
-                     declare_parameters, qos_profile, run_node)
+                     declare_parameters, qos_profile, run_node,
+                     SharedGraphNode)
 from ..core import NewtonEulerError
 from ..core.trajectory import TrajectoryFollower
 from ..feedforward import payload_model
@@ -105,7 +105,7 @@ def advance(dyn, q, qd, tau, t, period, dt, method, wrench_at=None):
     return q, qd
 
 
-class RobotSimNode(Node):
+class RobotSimNode(SharedGraphNode):
     """Simulate a scene; torques in on ~/commands, joint states out."""
 
     def __init__(self, **kwargs):

@@ -48,14 +48,13 @@ import sys
 from builtin_interfaces.msg import Duration
 import numpy as np
 from rclpy.duration import Duration as Span
-from rclpy.node import Node
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from .common import (ConfigurationError, declare_parameters, qos_profile,
-                     run_node)
+                     run_node, SharedGraphNode)
 from ..core import NewtonEulerError
 from ..parameters import load_specs
 from ..sim.scene import load_scene
@@ -94,7 +93,7 @@ def reference_message(scene, names, t0_stamp, sample=SAMPLE):
     return msg
 
 
-class TrackingControllerNode(Node):
+class TrackingControllerNode(SharedGraphNode):
     """PD tracking of a scene's reference, with inverse-dynamics torques."""
 
     def __init__(self, **kwargs):

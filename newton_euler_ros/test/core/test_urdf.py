@@ -487,7 +487,15 @@ BAD = [
      r'refused'),
     ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
      '<xacro:property name="a" value="1"/><link name="b"/></robot>',
-     r'xacro elements .*: expand it with xacro first'),
+     r'xacro, not URDF \(<xacro:property>\): expand it with xacro first$'),
+    ('<robot name="r" xmlns:xacro="http://ros.org/wiki/xacro"><link '
+     'name="b"/><link name="a"/><joint name="j" type="fixed"><parent '
+     'link="b"/><child link="a"/><origin xyz="0 0 ${h}"/></joint></robot>',
+     r'xacro, not URDF \(<origin xyz="0 0 \$\{h\}">\): expand it with '
+     r'xacro first$'),
+    ('<robot name="r"><link name="b"><visual><geometry><mesh filename='
+     '"$(find arm)/base.stl"/></geometry></visual></link></robot>',
+     r'xacro, not URDF \(<mesh filename="\$\(find arm\)/base.stl">\)'),
 ]
 
 
@@ -497,6 +505,29 @@ def test_bad_urdf_is_one_clear_error(text, message):
         load_urdf(text, tip='a')
     assert '\n' not in str(info.value)
     assert str(info.value).startswith('robot_description: ')
+
+
+def test_xacro_namespace_alone_is_not_xacro():
+    """Load a URDF with xmlns:xacro: xacro leaves it in what it writes."""
+    text = ('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+            + one_link()[len('<robot name="r">'):])
+    assert load_urdf(text, tip='a').n == 1
+
+
+def test_urdf_and_xacro_are_recognised_by_content(tmp_path):
+    """A URDF under another name loads; a xacro file is one line."""
+    xml = tmp_path / 'arm.xml'
+    xml.write_text('\ufeff\n  ' + one_link())
+    assert load_robot(str(xml), tip='a').n == 1
+    xacro = tmp_path / 'arm.urdf.xacro'
+    xacro.write_text('<?xml version="1.0"?>\n<robot name="r" xmlns:xacro='
+                     '"http://www.ros.org/wiki/xacro"><xacro:include '
+                     'filename="arm.xacro"/></robot>')
+    with pytest.raises(RobotFileError) as info:
+        load_robot(str(xacro))
+    assert str(info.value) == ('arm.urdf.xacro: xacro, not URDF '
+                               '(<xacro:include>): expand it with xacro '
+                               'first')
 
 
 def test_chain_errors_name_the_links():
@@ -538,14 +569,94 @@ def test_warnings_name_massless_links_and_lumped_subtrees():
     _, found, _ = inspect_urdf(ARM, base='world', tip='tool0')
     # tool0 is a massless frame on a fixed joint: nothing to say about it
     assert not any('massless' in w for w in found), found
-    assert any('lumped rigidly' in w and 'grip (prismatic)' in w
-               for w in found)
+    assert any('moving joints off the chain locked at zero' in w
+               and w.endswith(': grip (prismatic)') for w in found), found
     # a link a joint moves, without <inertial>, is worth a warning
     l3 = inertial(0.5, '0 0.02 0.03', '0.4 -0.2 0.1')
     bare = ARM.replace(f'<link name="l3">{l3}</link>', '<link name="l3"/>')
     assert bare != ARM
     _, found, _ = inspect_urdf(bare, base='world', tip='tool0')
     assert any('massless: l3' in w for w in found), found
+
+
+# what a real robot_description carries beside links and joints
+ROS2_CONTROL = """
+  <ros2_control name="arm" type="system">
+    <hardware><plugin>mock_components/GenericSystem</plugin></hardware>
+    <joint name="{joint}"><command_interface name="effort"/>
+      <state_interface name="position"/><state_interface name="velocity"/>
+    </joint>
+  </ros2_control>
+  <transmission name="{joint}_trans">
+    <type>transmission_interface/SimpleTransmission</type>
+    <joint name="{joint}">
+      <hardwareInterface>hardware_interface/EffortJointInterface
+      </hardwareInterface></joint>
+    <actuator name="{joint}_motor">
+      <mechanicalReduction>1</mechanicalReduction></actuator>
+  </transmission>
+  <gazebo reference="{link}"><material>Gazebo/Grey</material></gazebo>
+  <gazebo><plugin filename="libgazebo_ros2_control.so"
+    name="gazebo_ros2_control"><parameters>/tmp/controllers.yaml</parameters>
+  </plugin></gazebo>
+</robot>"""
+# a wrist camera on a fixed joint off the chain, with mass
+CAMERA = """
+  <link name="wrist_camera"><inertial><origin xyz="0 0 0.02"/>
+    <mass value="0.3"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4" ixy="0"
+    ixz="0" iyz="0"/></inertial></link>
+  <joint name="wrist_camera_joint" type="fixed"><parent link="{link}"/>
+    <child link="wrist_camera"/><origin xyz="0.05 0 0"/></joint>"""
+# (file, base, tip, a joint for the blocks, the link the camera is on)
+CORRECT = [
+    ('ur_description/urdf/ur5_robot.urdf', 'base_link', 'tool0',
+     'shoulder_pan_joint', 'wrist_3_link'),
+    ('kinova_description/robots/kinova.urdf', None,
+     'j2s6s200_end_effector', 'j2s6s200_joint_1', 'j2s6s200_link_6'),
+    ('xarm_description/urdf/xarm7.urdf', None, 'link_eef', 'joint1', 'link5'),
+    ('z1_description/urdf/z1.urdf', None, 'gripperMover', 'joint1', 'link05'),
+]
+
+
+@pytest.mark.parametrize('relative,base,tip,joint,link', CORRECT)
+def test_published_urdf_with_fixed_off_chain_parts_loads_quietly(
+        relative, base, tip, joint, link):
+    """
+    Load a correct model, as a bringup publishes it, without a warning.
+
+    ros2_control, transmission and gazebo blocks are ignored; a fixed
+    joint off the chain (the robot's own frames, a wrist camera with
+    mass) is merged without a word, and its mass is in the model.
+    """
+    from newton_euler_tools.peers import example_robot_urdf
+    with open(example_robot_urdf(relative), encoding='utf-8') as fh:
+        text = fh.read()
+    described = text.replace('</robot>', CAMERA.format(link=link)
+                             + ROS2_CONTROL.format(joint=joint, link=link))
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        plain = load_urdf(text, base=base, tip=tip)
+        model, found, report = inspect_urdf(described, base=base, tip=tip)
+    assert found == [] and report['locked'] == [], found
+    assert 'wrist_camera_joint' in report['lumped']
+    assert model.total_mass == pytest.approx(plain.total_mass + 0.3)
+
+
+def test_only_locked_moving_joints_are_warned_about():
+    """Merge the Panda's hand quietly (fixed); name its moving fingers."""
+    from newton_euler_tools.peers import example_robot_urdf
+    path = example_robot_urdf('panda_description/urdf/panda.urdf')
+    for tip in ('panda_link8', 'panda_hand_tcp'):
+        _, found, report = inspect_urdf(path, base='panda_link0', tip=tip)
+        assert report['locked'] == ['panda_finger_joint1',
+                                    'panda_finger_joint2']
+        assert found == [
+            'panda.urdf: moving joints off the chain locked at zero (their '
+            'motion is not modelled; their links are lumped rigidly into '
+            'the chain): panda_finger_joint1 (prismatic), '
+            'panda_finger_joint2 (prismatic, mimic of panda_finger_joint1, '
+            'at 0)'], found
+        assert not any('panda_hand_joint' in w for w in found)
 
 
 def test_massless_frames_lumped_or_written_back_do_not_warn():
@@ -618,6 +729,7 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
             '-[j3]-> l3 -[flange]-> tool0') in out
     assert 'merged fixed joints: mount, flange' in out
     assert 'lumped off-chain subtrees (at zero position): grip' in out
+    assert 'locked off-chain moving joints: grip' in out
     assert 'massless' not in out          # tool0 is a frame
     code, out, err = run_cli('check', str(path))
     assert code != 0 and err.count('\n') == 1 and '2 leaves' in err

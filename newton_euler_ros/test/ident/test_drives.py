@@ -16,6 +16,7 @@
 import os
 import warnings
 
+from descriptions import as_published
 from newton_euler_ros.core import inverse_dynamics, load_robot, RobotFileError
 from newton_euler_ros.core.drives import Drives, DRIVES_NS, model_drives
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf
@@ -119,8 +120,10 @@ def test_node_compensates_only_when_asked(tmp_path):
                              NodeProcess, Probe)
     from sensor_msgs.msg import JointState
     _, text = puma_urdf()
+    # as a ros2_control robot publishes it: every joint name also appears
+    # in <ros2_control> and <transmission> blocks after the tree
     path = tmp_path / 'puma_drives.urdf'
-    path.write_text(text)
+    path.write_text(as_published(text, 'franka'))
     model = quiet_urdf(text)
     drives = model_drives(model)
     domain = domain_id(61)

@@ -129,7 +129,7 @@ def test_bad_robot_file_error_names_field(tmp_path):
                     'd: 0.0, mass: -2.0, com: [0, 0, 0], '
                     'inertia: [1, 1, 1, 0, 0, 0]}\n')
     code, _, err = run('check', str(path))
-    assert code == 1
+    assert code == 2
     assert err.strip() == ('newton-euler: error: arm.yaml: links[0] (j1): '
                            'mass: must be >= 0, got -2.0')
 
@@ -192,7 +192,7 @@ def test_hostile_robot_and_scene_files_are_one_line(tmp_path, kind):
     for command in (('check', str(path)), ('simulate', str(path)),
                     ('dynamics', 'puma560', '--states', str(path))):
         code, out, err = run(*command)
-        assert code == 1, (command, err)
+        assert code == 2, (command, err)
         assert err.count('\n') == 1, (command, err)
         assert 'Traceback' not in err and out == ''
         if command[0] == 'dynamics' and kind in ('deep', 'alias bomb',
@@ -207,7 +207,7 @@ def test_exit_statuses(tmp_path):
     assert run('dynamics', 'puma560', '--q', '0')[0] == 2     # count
     assert run('dynamics', 'puma560', '--q', *PUMA_Q[:5], 'x')[0] == 2
     assert run('frobnicate')[0] == 2
-    assert run('dynamics', 'no_such_robot', '--q', '0')[0] == 1
+    assert run('dynamics', 'no_such_robot', '--q', '0')[0] == 2
     assert run('check', 'puma560')[0] == 0
 
 
