@@ -16,8 +16,12 @@
 ``newton-euler excite`` and ``newton-euler payload``: the loop's ends.
 
     newton-euler excite MODEL.urdf --base LINK --tip LINK -o TRAJECTORY.json
-                        [--period S] [--harmonics K] [--seconds S]
-                        [--seed N] [--start Q1 ... QN] [--rate HZ]
+                        --start Q1 ... QN [--period S] [--harmonics K]
+                        [--seconds S] [--seed N] [--rate HZ] [--budget S]
+                        [--range JOINT LO HI] [--max-velocity V [V ...]]
+                        [--max-acceleration A [A ...]] [--clearance M]
+                        [--floor Z | --no-floor] [--plane NX NY NZ D]
+                        [--box XMIN YMIN ZMIN XMAX YMAX ZMAX]
     newton-euler payload MODEL.urdf BAG --base LINK --tip LINK [--json]
                          [--topic T] [--cutoff HZ]
 
@@ -60,12 +64,39 @@ def register(subparsers):
                      help='seed of the random series the optimiser starts '
                           'from (default 0)')
     exc.add_argument('--start', type=float, nargs='+', metavar='Q',
-                     help='rest configuration at both ends (default: the '
-                          'middle of the limits of each joint)')
+                     required=True,
+                     help="the arm's pose now, one value per joint: the "
+                          'trajectory starts and ends there at rest')
     exc.add_argument('--rate', type=float, default=50.0, metavar='HZ',
                      help='trajectory points per second (default 50)')
     exc.add_argument('--budget', type=float, default=40.0, metavar='S',
                      help='optimisation time budget, s (default 40)')
+    exc.add_argument('--range', nargs=3, action='append', default=[],
+                     metavar=('JOINT', 'LO', 'HI'),
+                     help='keep JOINT in [LO, HI], inside its URDF limits '
+                          '(repeat for more joints)')
+    exc.add_argument('--max-velocity', type=float, nargs='+', metavar='V',
+                     help='speed limit, one value or one per joint (the '
+                          "URDF's where it is lower)")
+    exc.add_argument('--max-acceleration', type=float, nargs='+',
+                     metavar='A', help='acceleration limit, one value or '
+                     'one per joint (default 4 rad/s^2, 1 m/s^2)')
+    exc.add_argument('--clearance', type=float, default=0.05, metavar='M',
+                     help='least distance of every link from the floor '
+                          'and the planes, m (default 0.05)')
+    flo = exc.add_mutually_exclusive_group()
+    flo.add_argument('--floor', type=float, default=0.0, metavar='Z',
+                     help="keep above the base frame's plane z = Z "
+                          '(default 0: the mounting surface)')
+    flo.add_argument('--no-floor', action='store_true',
+                     help='no floor (an arm mounted over nothing)')
+    exc.add_argument('--plane', type=float, nargs=4, action='append',
+                     default=[], metavar=('NX', 'NY', 'NZ', 'D'),
+                     help='keep on the side n . p >= D of a plane of the '
+                          'base frame (a wall; repeat for more)')
+    exc.add_argument('--box', type=float, nargs=6, metavar=('XMIN', 'YMIN',
+                     'ZMIN', 'XMAX', 'YMAX', 'ZMAX'),
+                     help='keep inside this box of the base frame, m')
     exc.set_defaults(func=_one_line_exit_2(cmd_excite))
     pay = subparsers.add_parser(
         'payload', help='estimate the mass, centre of mass and inertia of '
@@ -92,7 +123,8 @@ def _model(path, base, tip):
 def cmd_excite(args):
     """Run ``newton-euler excite``."""
     from .core import NewtonEulerError
-    from .ident.excite import excite, trajectory_json
+    from .ident.excite import (excite, model_limits, narrowed,
+                               trajectory_json)
     from .ident.urdf_out import atomic_write
     out = os.path.abspath(args.output)
     if not os.path.isdir(os.path.dirname(out)):
@@ -101,17 +133,22 @@ def cmd_excite(args):
                    ('--budget', args.budget)):
         if v is not None and not (v > 0 and math.isfinite(v)):
             _fail(f'{opt} must be a positive number, got {v:g}')
-    model, _, notes = _model(args.model, args.base, args.tip)
+    model, text, notes = _model(args.model, args.base, args.tip)
     for line in notes:
         print(line, file=sys.stderr)
     try:
+        limits = narrowed(model, model_limits(model), _ranges(args.range),
+                          args.max_velocity, args.max_acceleration)
+        clearance = _clearance(args, model, text)
         exc = excite(model, period=args.period, harmonics=args.harmonics,
-                     seed=args.seed, start=args.start, budget=args.budget)
+                     seed=args.seed, start=args.start, budget=args.budget,
+                     limits=limits, clearance=clearance)
     except NewtonEulerError as exc_:
         _fail(f'{args.model}: {exc_}')
     for line in exc.limits.notes:
         print(f'note: {line}', file=sys.stderr)
     traj = trajectory_json(exc, args.seconds, args.rate)
+    rows = _checked_clearance(args, clearance, traj)
     try:
         atomic_write(out, json.dumps(traj, separators=(',', ':')))
     except OSError as err:
@@ -125,20 +162,103 @@ def cmd_excite(args):
           f'{exc.condition_random:.3g} for the random series of seed '
           f'{args.seed} ({exc.evaluations} evaluations, '
           f'{exc.seconds:.1f} s)')
-    m = exc.margins
+    _print_limits(exc, model)
+    if rows:
+        _print_clearance(exc, rows)
+    print(f'wrote {args.output}')
+    return 0
+
+
+def _print_limits(exc, model):
+    m, lim = exc.margins, exc.limits
     print('limits used (margin 5 %: position 5 % of the range inside each '
           'limit, speed and acceleration at most 95 %):')
     w = max(len(x) for x in model.joint_names) + 2
     print(f'  {"joint":<{w}}{"q min":>9}{"q max":>9}{"pos margin":>12}'
-          f'{"|qd|/limit":>12}{"|qdd|/limit":>13}')
+          f'{"|qd|/limit":>12}{"|qdd|/limit":>13}{"qd limit":>10}'
+          f'{"qdd limit":>11}')
     for j, name in enumerate(model.joint_names):
         pm = m['position'][j]
         pos = '-' if not np.isfinite(pm) else f'{100 * pm:.1f} %'
         print(f'  {name:<{w}}{m["q_min"][j]:>9.3f}{m["q_max"][j]:>9.3f}'
               f'{pos:>12}{100 * m["velocity"][j]:>10.1f} %'
-              f'{100 * m["acceleration"][j]:>11.1f} %')
-    print(f'wrote {args.output}')
-    return 0
+              f'{100 * m["acceleration"][j]:>11.1f} %'
+              f'{lim.velocity[j]:>10.3g}{lim.acceleration[j]:>11.3g}')
+
+
+def _ranges(raw):
+    out = []
+    for name, lo, hi in raw:
+        try:
+            out.append((name, float(lo), float(hi)))
+        except ValueError:
+            _fail(f'--range {name} {lo} {hi}: LO and HI must be numbers')
+    return out
+
+
+def _clearance(args, model, text):
+    """Return the Clearance the options ask for, or None; notes on stderr."""
+    from .ident.clearance import box, Clearance, floor, Plane
+    if not (args.clearance >= 0 and math.isfinite(args.clearance)):
+        _fail(f'--clearance must be a number >= 0, got {args.clearance:g}')
+    try:
+        planes = [] if args.no_floor else [floor(args.floor)]
+        planes += [Plane.make(p[:3], p[3], 'plane ' + ' '.join(
+            f'{x:g}' for x in p)) for p in args.plane]
+        if args.box:
+            planes += box(args.box[:3], args.box[3:])
+    except ValueError as exc:
+        _fail(f'--floor/--plane/--box: {exc}')
+    if not planes:
+        return None
+    cl = Clearance.of_urdf(model, text, args.model, planes, args.clearance)
+    if cl.bare:
+        names = [name for name, _ in cl.bare]
+        shown = ', '.join(names[:6]) + (' ...' if len(names) > 6 else '')
+        why = cl.bare[0][1] or 'no geometry'
+        print(f'note: no readable geometry for {len(names)} link(s) '
+              f'({shown}; {names[0]}: {why}): bounded by their origins',
+              file=sys.stderr)
+    return cl
+
+
+def _checked_clearance(args, cl, traj):
+    """Check every written point by forward kinematics; report rows."""
+    if cl is None:
+        return []
+    Q = np.array([p['positions'] for p in traj['points']])
+    t = np.array([p['time_from_start'] for p in traj['points']])
+    rows = cl.report(Q, t)
+    bad = [r for r in rows if r[3] < r[5] - 1e-9]
+    if bad:
+        plane, body, _, least, when, need = min(
+            bad, key=lambda r: r[3] - r[5])
+        _fail(f'{args.model}: the trajectory would bring {body} to '
+              f'{least:.4f} m from the {plane} at t = {when:.2f} s '
+              f'(needs {need:.4f}); nothing written')
+    return rows
+
+
+def _print_clearance(exc, rows):
+    cl = exc.clearance
+    print(f'clearance kept at every written point (forward kinematics; '
+          f'links bounded by their geometry and origins; margin '
+          f'{cl.margin:g} m'
+          + ('' if exc.shrink >= 1 else f'; the motion scaled to '
+             f'{100 * exc.shrink:.0f} % to keep it') + '):')
+    nearest = {}
+    for row in rows:
+        if row[1] not in nearest or row[3] < nearest[row[1]][3]:
+            nearest[row[1]] = row
+    w = max(len(b) for b in nearest) + 2
+    pw = max(len(r[0]) for r in nearest.values()) + 2
+    print(f'  {"link":<{w}}{"nearest plane":<{pw}}{"at start":>10}'
+          f'{"least":>9}{"at t":>8}{"kept >=":>9}')
+    for body, (plane, _, start, least, when, need) in nearest.items():
+        held = ' (held: within the margin at the start)' \
+            if need < cl.margin else ''
+        print(f'  {body:<{w}}{plane:<{pw}}{start:>10.3f}{least:>9.3f}'
+              f'{when:>8.2f}{need:>9.3f}{held}')
 
 
 def cmd_payload(args):

@@ -16,7 +16,8 @@
 ``newton-euler send`` and ``newton-euler record``: the loop on a live graph.
 
     newton-euler send TRAJECTORY.json [--topic T] [--start-in S] [--wait S]
-                      [--no-follow]
+                      [--no-follow] [--joint-states T] [--tolerance R]
+                      [--move-to-start] [--move-speed V]
     newton-euler record BAG [--topic T] [--duration S] [--max-messages N]
                         [--storage mcap|sqlite3] [--wait S]
 
@@ -26,6 +27,14 @@ inverse_dynamics_node's ``~/trajectory_in`` (efforts filled, passed on to
 the controller) or straight to joint_trajectory_controller's
 ``~/joint_trajectory``.  It waits for a subscriber, for the message to be
 acknowledged and (unless ``--no-follow``) for the trajectory to end.
+Before it sends, it reads the robot's joint positions on
+``/joint_states`` (``--joint-states``; the latest value of each joint,
+whichever message carries it) and refuses, in one line giving each
+joint's offset, unless every joint is within ``--tolerance`` of the
+trajectory's first point.  With ``--move-to-start`` it first sends, the
+same way, a rest-to-rest quintic from where the robot is to that point,
+no joint faster than ``--move-speed``, and checks again once it has
+ended.
 
 ``record`` writes ``sensor_msgs/JointState`` messages to a rosbag2 (MCAP
 by default) as they arrive, raw (no decoding on the way), with the
@@ -33,7 +42,11 @@ arrival time as the recording time: what ``identify``, ``payload`` and
 ``observe`` read, without the ``ros2`` CLI.  Its subscription is reliable
 unless a publisher on the topic is best effort.  It stops after
 ``--duration`` seconds of recording, ``--max-messages`` messages, or on
-Ctrl-C (SIGINT) or SIGTERM; the bag is complete in every case.
+Ctrl-C (SIGINT), SIGTERM or SIGHUP (a closed terminal or ssh session);
+the bag is complete in every case.  What it has recorded reaches the disk
+every ``SYNC_S`` seconds (a closed MCAP chunk, fsynced; a committed
+sqlite3 transaction), so a SIGKILL or a power cut loses at most that
+much, and the reading commands recover the rest.
 
 Both need rclpy (the ROS 2 wheels of ``make setup``); every other command
 of ``newton-euler`` runs without it.
@@ -51,6 +64,7 @@ MAX_TRAJECTORY_BYTES = 64 * 1024 * 1024
 MAX_POINTS = 1_000_000
 FIELDS = ('positions', 'velocities', 'accelerations', 'effort')
 JOINT_STATE = 'sensor_msgs/msg/JointState'
+SYNC_S = 0.5          # record: what is recorded is on the disk this often
 
 
 class RosCliError(Exception):
@@ -76,11 +90,24 @@ def register(subparsers):
                           'now (0: a zero stamp, "start on receipt"; '
                           'default %(default)s)')
     snd.add_argument('--wait', type=float, default=10.0, metavar='S',
-                     help='seconds to wait for a subscriber (default '
-                          '%(default)s)')
+                     help="seconds to wait for a subscriber, the robot's "
+                          'joint states and its arrival at the start '
+                          '(default %(default)s)')
     snd.add_argument('--no-follow', action='store_true',
                      help='return once the message is acknowledged, not '
                           'when the trajectory ends')
+    snd.add_argument('--joint-states', default='/joint_states', metavar='T',
+                     help="where the robot's joint positions are read "
+                          '(default: %(default)s)')
+    snd.add_argument('--tolerance', type=float, default=0.02, metavar='R',
+                     help='how far (rad or m) a joint may be from the '
+                          "trajectory's first point (default %(default)s)")
+    snd.add_argument('--move-to-start', action='store_true',
+                     help="first move the arm to the trajectory's first "
+                          'point, slowly, if it is not there')
+    snd.add_argument('--move-speed', type=float, default=0.2, metavar='V',
+                     help='top joint speed of that move, rad/s or m/s '
+                          '(default %(default)s)')
     snd.set_defaults(func=cmd_send)
     rec = subparsers.add_parser(
         'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
@@ -183,7 +210,7 @@ def trajectory_message(names, points, stamp_ns):
 # ---- running on a graph ----------------------------------------------------
 
 class _Ros:
-    """rclpy in a context of its own, stopped by SIGINT and SIGTERM."""
+    """rclpy in a context of its own, stopped by SIGINT, SIGTERM, SIGHUP."""
 
     def __init__(self, name):
         import rclpy
@@ -191,7 +218,7 @@ class _Ros:
         from rclpy.signals import SignalHandlerOptions
         self.stop = []
         self._old = {}
-        for sig in (signal.SIGINT, signal.SIGTERM):
+        for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
             self._old[sig] = signal.signal(
                 sig, lambda signum, frame: self.stop.append(signum))
         self.rclpy = rclpy
@@ -226,44 +253,192 @@ def _check_seconds(value, option, allow_zero=True):
                           f'{">=" if allow_zero else ">"} 0, got {value}')
 
 
-def cmd_send(args):
-    """Publish a trajectory file once; follow it to its end."""
-    for option in ('start_in', 'wait'):
-        _check_seconds(getattr(args, option), '--' + option.replace('_', '-'))
-    names, points = read_trajectory(args.trajectory)
-    from rclpy.duration import Duration
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from trajectory_msgs.msg import JointTrajectory
-    ros = _Ros('newton_euler_send')
-    try:
-        pub = ros.node.create_publisher(
+class _Positions:
+    """The latest position of each named joint on a JointState topic."""
+
+    def __init__(self, names):
+        self.names = list(names)
+        self.latest = {}
+
+    def __call__(self, msg):
+        for name, q in zip(msg.name, msg.position):
+            if name in self.names and math.isfinite(q):
+                self.latest[name] = float(q)
+
+    def complete(self):
+        return all(n in self.latest for n in self.names)
+
+    def vector(self):
+        return [self.latest[n] for n in self.names]
+
+
+def approach(names, here, goal, speed, rate=50.0):
+    """
+    Points of a rest-to-rest quintic from ``here`` to ``goal``.
+
+    Its duration makes the fastest joint peak at ``speed`` (the quintic's
+    peak speed is 1.875 times the mean), at least one second.
+    """
+    here, goal = (list(map(float, v)) for v in (here, goal))
+    dist = max(abs(g - h) for g, h in zip(goal, here))
+    total = max(1.0, 1.875 * dist / speed)
+    count = max(2, int(math.ceil(total * rate)))
+    points = []
+    for i in range(count + 1):
+        t = total * i / count
+        s = t / total
+        p = 10 * s ** 3 - 15 * s ** 4 + 6 * s ** 5
+        dp = (30 * s ** 2 - 60 * s ** 3 + 30 * s ** 4) / total
+        ddp = (60 * s - 180 * s ** 2 + 120 * s ** 3) / total ** 2
+        points.append({
+            'time_from_start': t,
+            'positions': [h + (g - h) * p for g, h in zip(goal, here)],
+            'velocities': [(g - h) * dp for g, h in zip(goal, here)],
+            'accelerations': [(g - h) * ddp for g, h in zip(goal, here)]})
+    return points
+
+
+def _offsets(names, here, goal):
+    return [h - g for h, g in zip(here, goal)]
+
+
+def _off_text(names, off):
+    return ', '.join(f'{n} {d:+.4f}' for n, d in zip(names, off))
+
+
+class _Sender:
+    """Publishes trajectories on one topic and follows them."""
+
+    def __init__(self, ros, args):
+        from rclpy.qos import QoSProfile, ReliabilityPolicy
+        from sensor_msgs.msg import JointState
+        from trajectory_msgs.msg import JointTrajectory
+        self.ros, self.args = ros, args
+        self.pub = ros.node.create_publisher(
             JointTrajectory, args.topic,
             QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE))
-        if not ros.spin_until(lambda: pub.get_subscription_count() > 0,
+        self.state = None
+        self._joint_state = JointState
+
+    def watch(self, names):
+        """Subscribe to the robot's joint positions."""
+        self.state = _Positions(names)
+        self.ros.node.create_subscription(
+            self._joint_state, self.args.joint_states, self.state, 100)
+
+    def wait_ready(self):
+        """Wait for a subscriber and every joint's position; or refuse."""
+        args, ros = self.args, self.ros
+        if not ros.spin_until(lambda: self.pub.get_subscription_count() > 0,
                               args.wait):
-            if ros.stop:
-                return 130
-            raise RosGraphError(f'no subscriber on {args.topic} after '
-                                f'{args.wait:g} s (is the node or the '
-                                f'controller running, in this '
-                                f'ROS_DOMAIN_ID?)')
-        now = ros.node.get_clock().now().nanoseconds
+            if not ros.stop:
+                raise RosGraphError(
+                    f'no subscriber on {args.topic} after {args.wait:g} s '
+                    f'(is the node or the controller running, in this '
+                    f'ROS_DOMAIN_ID?)')
+            return False
+        if self.state is None:
+            return True
+        if not ros.spin_until(self.state.complete, args.wait):
+            if not ros.stop:
+                missing = [n for n in self.state.names
+                           if n not in self.state.latest]
+                raise RosGraphError(
+                    f'no position of {", ".join(missing[:6])} on '
+                    f'{args.joint_states} after {args.wait:g} s (is the '
+                    f'robot driver running? --joint-states names the '
+                    f'topic)')
+            return False
+        return True
+
+    def send(self, names, points, what='sent', follow=True):
+        """Publish once (and follow); return False if stopped."""
+        from rclpy.duration import Duration
+        args = self.args
+        now = self.ros.node.get_clock().now().nanoseconds
         start = now + int(args.start_in * 1e9) if args.start_in > 0 else 0
-        pub.publish(trajectory_message(names, points, start))
-        if not pub.wait_for_all_acked(Duration(seconds=5.0)):
+        self.pub.publish(trajectory_message(names, points, start))
+        if not self.pub.wait_for_all_acked(Duration(seconds=5.0)):
             print(f'newton-euler: warning: {args.topic}: not acknowledged '
                   f'within 5 s', file=sys.stderr)
         end_s = args.start_in + points[-1]['time_from_start']
-        print(f'sent {len(points)} points for {len(names)} joints to '
+        print(f'{what} {len(points)} points for {len(names)} joints to '
               f'{args.topic}, starting in {args.start_in:g} s (stamp '
               f'{start // 10 ** 9}.{start % 10 ** 9:09d}), '
               f'{points[-1]["time_from_start"]:g} s long', flush=True)
-        if not args.no_follow:
-            done = time.monotonic() + end_s
-            ros.spin_until(lambda: time.monotonic() >= done, None)
-            if ros.stop:
-                return 130
-            print('trajectory ended', flush=True)
+        return self.follow(end_s) if follow else True
+
+    def follow(self, seconds):
+        """Spin for ``seconds``; False if stopped."""
+        done = time.monotonic() + seconds
+        self.ros.spin_until(lambda: time.monotonic() >= done, None)
+        return not self.ros.stop
+
+    def offsets(self, names, goal):
+        return _offsets(names, self.state.vector(), goal)
+
+
+def _check_send_args(args):
+    for option in ('start_in', 'wait'):
+        _check_seconds(getattr(args, option), '--' + option.replace('_', '-'))
+    _check_seconds(args.tolerance, '--tolerance')
+    _check_seconds(args.move_speed, '--move-speed', allow_zero=False)
+
+
+def _at_start(sender, names, goal, tol):
+    """Return True if at the start; else move or refuse (RosGraphError)."""
+    args = sender.args
+    off = sender.offsets(names, goal)
+    worst = max(abs(d) for d in off)
+    if worst <= tol:
+        print(f"the robot is at the trajectory's first point (largest "
+              f'offset {worst:.4f}, tolerance {tol:g})', flush=True)
+        return True
+    if not args.move_to_start:
+        raise RosGraphError(
+            f"the robot is not at the trajectory's first point (tolerance "
+            f'{tol:g}; robot - start: {_off_text(names, off)}): move it '
+            f'there, or add --move-to-start')
+    move = approach(names, sender.state.vector(), goal, args.move_speed)
+    print(f'moving to the start at {args.move_speed:g} rad/s at most '
+          f'(largest offset {worst:.4f})', flush=True)
+    if not sender.send(names, move, what='moving:'):
+        return False
+    # the controller may lag the wall clock: give it --wait s to arrive
+    if not sender.ros.spin_until(
+            lambda: max(map(abs, sender.offsets(names, goal))) <= tol,
+            args.wait):
+        if sender.ros.stop:
+            return False
+        off = sender.offsets(names, goal)
+        raise RosGraphError(
+            f"the robot did not reach the trajectory's first point within "
+            f'{args.wait:g} s of the move (tolerance {tol:g}; robot - '
+            f'start: {_off_text(names, off)}); nothing else sent')
+    return _at_start(sender, names, goal, tol)
+
+
+def cmd_send(args):
+    """Check the start, publish a trajectory file once, follow it."""
+    _check_send_args(args)
+    names, points = read_trajectory(args.trajectory)
+    if 'positions' not in points[0]:
+        raise RosCliError(f'{args.trajectory}: points[0] has no positions: '
+                          f'the start cannot be checked')
+    ros = _Ros('newton_euler_send')
+    try:
+        sender = _Sender(ros, args)
+        sender.watch(names)
+        if not sender.wait_ready():
+            return 130
+        if not _at_start(sender, names, points[0]['positions'],
+                         args.tolerance):
+            return 130
+        if not sender.send(names, points, follow=not args.no_follow):
+            return 130
+        if args.no_follow:
+            return 0
+        print('trajectory ended', flush=True)
     finally:
         ros.close()
     return 0
@@ -279,10 +454,19 @@ class _Recorder:
         self.first = self.last = None
 
     def start(self):
-        from .ident.bag import open_writer
+        from .ident.bag import open_writer, sync_directory, sync_writer
         self.writer, self.conn, _ = open_writer(self.args.bag,
                                                 self.args.topic,
                                                 self.args.storage)
+        self._sync = sync_writer
+        sync_writer(self.writer)
+        sync_directory(self.args.bag)
+        sync_directory(os.path.dirname(os.path.abspath(self.args.bag)))
+
+    def sync(self):
+        """Put what is recorded on the disk (a timer calls it)."""
+        if self.writer is not None and self.count:
+            self._sync(self.writer)
 
     def __call__(self, raw):
         now = time.time_ns()
@@ -354,9 +538,10 @@ def cmd_record(args):
             JointState, topic, rec, QoSProfile(
                 depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT
                 if best_effort else ReliabilityPolicy.RELIABLE), raw=True)
-        print(f'recording {topic} into {args.bag} '
-              f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
-              f'stops', flush=True)
+        ros.node.create_timer(SYNC_S, rec.sync)
+        _say(f'recording {topic} into {args.bag} '
+             f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
+             f'stops')
         ros.spin_until(rec.done, None)
     finally:
         rec.close()
@@ -364,10 +549,26 @@ def cmd_record(args):
     if not rec.count:
         if rec.writer is not None:
             shutil.rmtree(args.bag, ignore_errors=True)
-        print(f'newton-euler: no message received on {args.topic}; no bag '
-              f'written', file=sys.stderr)
+        _say(f'newton-euler: no message received on {args.topic}; no bag '
+             f'written', sys.stderr)
         return 1
     seconds = (rec.last - rec.first) * 1e-9
-    print(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
-          f'into {args.bag}', flush=True)
+    how = {signal.SIGINT: ' (Ctrl-C)', signal.SIGTERM: ' (SIGTERM)',
+           signal.SIGHUP: ' (SIGHUP)'}.get(ros.stop[0] if ros.stop else None,
+                                           '')
+    _say(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
+         f'into {args.bag}{how}')
     return 0
+
+
+def _say(text, stream=None):
+    """Print a line; a terminal gone (SIGHUP) is no error: drop it."""
+    stream = sys.stdout if stream is None else stream
+    try:
+        print(text, file=stream, flush=True)
+    except OSError:
+        # stdout and stderr to /dev/null, so that the exit flush cannot
+        # fail either
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)

@@ -39,12 +39,18 @@ What real recordings need, and what this module does about it:
   over windows of recording time, so a long recording never has to be in
   memory at once.
 
-Every problem with the file raises :class:`BagError` with one line naming
-the bag and what is wrong (missing, corrupt or truncated, no such topic,
-no effort, a chain joint missing, too short).
+A damaged recording (no ``metadata.yaml``, a storage file cut short: a
+recorder killed, a power cut, a copy cut off) is read up to its last
+intact message (``ident.bag_recover``), and one line on stderr says what
+was recovered.  Every other problem with the file raises
+:class:`BagError` with one line naming the bag and what is wrong
+(missing, corrupt, no such topic, no effort, a chain joint missing, too
+short).
 """
 from dataclasses import dataclass, field
+import os
 from pathlib import Path
+import sys
 
 import numpy as np
 
@@ -122,10 +128,10 @@ def _one_line(err):
     return text if len(text) <= 200 else text[:197] + '...'
 
 
-def _connections(reader, label, topic):
-    conns = [c for c in reader.connections if c.topic == topic]
+def _connections(connections, label, topic):
+    conns = [c for c in connections if c.topic == topic]
     if not conns:
-        topics = sorted({c.topic for c in reader.connections})
+        topics = sorted({c.topic for c in connections})
         shown = ', '.join(topics[:8]) + (' ...' if len(topics) > 8 else '')
         raise BagError(f'{label}: no topic {topic!r} in the bag (topics: '
                        f'{shown or "none"})')
@@ -134,6 +140,124 @@ def _connections(reader, label, topic):
         raise BagError(f'{label}: topic {topic!r} carries {bad[0]}, not '
                        f'{JOINT_STATE}')
     return conns
+
+
+# ---- the reading layer: a bag, possibly damaged, as decoded messages ------
+
+_REPORTED = set()
+
+
+def _report(line):
+    """Say once per process, on stderr, what was recovered of a bag."""
+    if line not in _REPORTED:
+        _REPORTED.add(line)
+        print(f'warning: {line}', file=sys.stderr, flush=True)
+
+
+def bag_messages(path, topic=DEFAULT_TOPIC, counts=None, notes=None):
+    """
+    Yield (log time ns, decoded message) of ``topic``, in recording order.
+
+    An intact bag is read by ``rosbags``; a damaged one (see
+    ``bag_recover.damage``) up to its last intact message, and one line
+    on stderr (and in ``notes``) says what was recovered.  ``counts``
+    ['messages'] counts the messages decoded.  Raises :class:`BagError`:
+    no bag, no such topic, a topic of another type or without messages, a
+    message that cannot be decoded, or a corrupt bag.
+    """
+    from .bag_recover import damage
+    counts = {'messages': 0} if counts is None else counts
+    label = _label(path)
+    if not Path(path).exists():
+        raise BagError(f'{label}: no such bag (file or directory)')
+    why = damage(str(path))
+    if why is None:
+        reader = _open(path)
+        try:
+            conns = _connections(reader.connections, label, topic)
+            if sum(c.msgcount for c in conns) == 0:
+                raise BagError(f'{label}: topic {topic!r} has no messages')
+            yield from _decoded(reader, conns, label, topic, counts)
+        finally:
+            try:
+                reader.close()
+            except Exception:  # noqa: BLE001, S110 (already failing)
+                pass
+        return
+    yield from _recovered(path, label, topic, why, counts, notes)
+
+
+def _scan(path, label):
+    """Storage scanners of a damaged bag, with a first pass done."""
+    from .bag_recover import Damaged, scanners
+    scans = scanners(str(path))
+    stats = {'first': None, 'last': None, 'count': {}}
+    for scan in scans:
+        try:
+            for cid, logtime, _ in scan.messages():
+                c = stats['count']
+                c[(scan.path, cid)] = c.get((scan.path, cid), 0) + 1
+                if stats['first'] is None:
+                    stats['first'] = logtime
+                stats['last'] = logtime
+        except Damaged as err:
+            raise BagError(f'{label}: cannot be recovered: {err}') from None
+    return scans, stats
+
+
+def _recovered(path, label, topic, why, counts, notes):
+    """Messages of a damaged bag; one line says what was recovered."""
+    from rosbags.typesys import get_typestore, Stores
+    from .bag_recover import PLAIN_CUTS
+    scans, stats = _scan(path, label)
+    conns = []
+    for scan in scans:
+        for cid, conn in scan.channels.items():
+            conn.msgcount = stats['count'].get((scan.path, cid), 0)
+            conns.append(conn)
+    files = ', '.join(os.path.basename(s.path) for s in scans)
+    if not conns:
+        raise BagError(f'{label}: {why}; nothing can be recovered from '
+                       f'{files} (it ends before its first message)')
+    conns = _connections(conns, label, topic)
+    total = sum(c.msgcount for c in conns)
+    cut = '; '.join(f'{os.path.basename(s.path)} stops at {s.cut}'
+                    for s in scans if s.cut and s.cut not in PLAIN_CUTS)
+    if total == 0:
+        raise BagError(f'{label}: {why}; no message on {topic!r} can be '
+                       f'recovered from {files}')
+    seconds = (stats['last'] - stats['first']) * 1e-9
+    line = (f'recording {label}: {why}; recovered {total} messages on '
+            f'{topic} up to t = {seconds:.1f} s from {files}'
+            + (f' ({cut})' if cut else ''))
+    _report(line)
+    if notes is not None:
+        notes.append(line)
+    ts = get_typestore(Stores.ROS2_JAZZY)
+    for scan in scans:
+        wanted = {cid for cid, c in scan.channels.items() if c.topic == topic}
+        for cid, logtime, raw in scan.messages():
+            if cid not in wanted:
+                continue
+            try:
+                msg = ts.deserialize_cdr(raw, JOINT_STATE)
+            except Exception as err:  # noqa: BLE001
+                raise BagError(f'{label}: message {counts["messages"]} on '
+                               f'{topic!r} cannot be decoded (corrupt '
+                               f'bag?): {_one_line(err)}') from None
+            counts['messages'] += 1
+            yield logtime, msg
+
+
+def recovered_seconds(path):
+    """Length (log time, s) of a damaged bag's readable part, or None."""
+    from .bag_recover import damage
+    if not Path(path).is_dir() or damage(str(path)) is None:
+        return None
+    _, stats = _scan(path, _label(path))
+    if stats['first'] is None:
+        return 0.0
+    return (stats['last'] - stats['first']) * 1e-9
 
 
 class _Selector:
@@ -295,30 +419,19 @@ def iter_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
     """
     label = _label(path)
     joint_names = tuple(joint_names)
-    reader = _open(path)
     counts = {'messages': 0, 'kept': 0, 'duplicates': 0, 'backwards': 0,
               'no_effort': 0, 'no_position': 0, 'missing_joint': 0}
     notes = []
-    try:
-        conns = _connections(reader, label, topic)
-        if sum(c.msgcount for c in conns) == 0:
-            raise BagError(f'{label}: topic {topic!r} has no messages')
-        samples = _Samples(_Selector(joint_names, label, topic), counts,
-                           notes)
-        buf = _Chunk(chunk, len(joint_names))
-        for logtime, msg in _decoded(reader, conns, label, topic, counts):
-            sample = samples.take(logtime, msg)
-            if sample is not None and buf.add(*sample):
-                yield buf.take(samples.have_qd, joint_names, counts, notes)
-        _check_totals(label, topic, counts, samples.missing_seen,
-                      min_samples, samples.select.names_seen())
-        if buf.k:
+    samples = _Samples(_Selector(joint_names, label, topic), counts, notes)
+    buf = _Chunk(chunk, len(joint_names))
+    for logtime, msg in bag_messages(path, topic, counts, notes):
+        sample = samples.take(logtime, msg)
+        if sample is not None and buf.add(*sample):
             yield buf.take(samples.have_qd, joint_names, counts, notes)
-    finally:
-        try:
-            reader.close()
-        except Exception:  # noqa: BLE001, S110 (already failing)
-            pass
+    _check_totals(label, topic, counts, samples.missing_seen, min_samples,
+                  samples.select.names_seen())
+    if buf.k:
+        yield buf.take(samples.have_qd, joint_names, counts, notes)
 
 
 def _windowed(reader, conns, window_ns=WINDOW_NS):
@@ -394,6 +507,9 @@ def read_joint_states(path, joint_names, topic=DEFAULT_TOPIC,
 
 def recording_seconds(path):
     """Return the recording's length in seconds (log time), or BagError."""
+    seconds = recovered_seconds(path)
+    if seconds is not None:
+        return seconds
     reader = _open(path)
     try:
         return reader.duration * 1e-9
@@ -426,6 +542,41 @@ def open_writer(path, topic=DEFAULT_TOPIC, storage='mcap'):
         writer.close()
         raise
     return writer, conn, ts
+
+
+def sync_writer(writer):
+    """
+    Put what ``writer`` (from :func:`open_writer`) has so far on the disk.
+
+    MCAP: the pending chunk is closed (a complete chunk record, readable
+    without the summary a close writes) and the file flushed and fsynced;
+    sqlite3: the open transaction is committed (sqlite syncs on commit).
+    After it, a killed process or a power cut loses nothing written
+    before.  rosbags' writers keep the file and the pending chunk in
+    ``writer.storage`` (rosbags 0.11).
+    """
+    import os
+    storage = writer.storage
+    if storage is None:
+        return
+    conn = getattr(storage, 'conn', None)
+    if conn is not None:                            # sqlite3
+        conn.commit()
+        return
+    if storage.chunk.msgs:                          # MCAP
+        storage.close_chunk()
+    storage.bio.flush()
+    os.fsync(storage.bio.fileno())
+
+
+def sync_directory(path):
+    """Fsync a directory, so that the files just created in it survive."""
+    import os
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
 
 
 def write_joint_states(path, stamps_ns, names, q, qd, effort,

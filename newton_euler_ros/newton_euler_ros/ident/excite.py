@@ -48,6 +48,18 @@ scaled the same way: its condition number is the baseline printed.
 A request whose limits leave a joint less than ``MIN_SWING`` of its
 range (a period too short for its velocity or acceleration limit) is
 refused with the shortest period that would do.
+
+The user narrows the limits (:func:`narrowed`: a joint range inside the
+URDF's, lower velocity limits, acceleration limits) and may keep the arm
+clear of planes (``ident.clearance``: the mounting surface, walls, a
+workcell box).  Clearance is not linear in the coefficients: after the
+per-joint scaling, the whole motion about the start is shrunk by the
+largest factor in [0, 1] that keeps every body clear on the grid
+(bisection; the start itself is clear), so the optimiser still sees
+only feasible trajectories and is steered away from motions that must
+shrink.  The result is checked again on the fine grid; a motion that the
+clearance shrinks below ``MIN_SWING`` of a joint's range is refused as
+not useful.
 """
 from dataclasses import dataclass, field
 import math
@@ -103,6 +115,8 @@ class Excitation:
     evaluations: int
     limits: Limits
     margins: dict = field(default_factory=dict)
+    clearance: object = None     # ident.clearance.Clearance, or None
+    shrink: float = 1.0          # of the motion, kept by the clearance
 
     def sample(self, t):
         """Return (q, qd, qdd) at times t, each (len(t), n)."""
@@ -145,6 +159,51 @@ def model_limits(model):
         vel[j] = v
         acc[j] = DEFAULT_ACCELERATION_P if prism else DEFAULT_ACCELERATION
     return Limits(lo, hi, vel, acc, notes)
+
+
+def narrowed(model, limits, ranges=(), max_velocity=None,
+             max_acceleration=None):
+    """
+    Return ``limits`` narrowed by the user (ExcitationError if not inside).
+
+    ``ranges``: (joint name, lower, upper) inside the joint's URDF limits;
+    ``max_velocity``: one value for every joint or one per joint, the
+    lower of it and the URDF's is used; ``max_acceleration``: the same,
+    replacing the default (URDF has no acceleration limit).
+    """
+    lo, hi = limits.lower.copy(), limits.upper.copy()
+    vel, acc = limits.velocity.copy(), limits.acceleration.copy()
+    names = list(model.joint_names)
+    for name, a, b in ranges:
+        if name not in names:
+            raise ExcitationError(f'--range: no joint {name!r} in the chain '
+                                  f'(joints: {", ".join(names)})')
+        j = names.index(name)
+        if not (math.isfinite(a) and math.isfinite(b) and a < b):
+            raise ExcitationError(f'--range {name}: needs LOWER < UPPER, '
+                                  f'got {a:g} {b:g}')
+        if a < lo[j] or b > hi[j]:
+            raise ExcitationError(
+                f'--range {name} {a:g} {b:g}: not inside its URDF limits '
+                f'[{lo[j]:g}, {hi[j]:g}]')
+        lo[j], hi[j] = a, b
+    for option, values, out in (('--max-velocity', max_velocity, vel),
+                                ('--max-acceleration', max_acceleration,
+                                 acc)):
+        if values is None:
+            continue
+        values = np.atleast_1d(np.asarray(values, dtype=np.float64))
+        if values.size not in (1, len(names)):
+            raise ExcitationError(f'{option}: one value or one per joint '
+                                  f'({len(names)}), got {values.size}')
+        if not (np.isfinite(values).all() and (values > 0).all()):
+            raise ExcitationError(f'{option}: must be positive numbers')
+        values = np.broadcast_to(values, out.shape)
+        if option == '--max-velocity':
+            out[:] = np.minimum(out, values)
+        else:
+            out[:] = values
+    return Limits(lo, hi, vel, acc, list(limits.notes))
 
 
 def _usable(limits, start):
@@ -226,7 +285,7 @@ def _null_basis(K, period):
 
 class _Problem:
     def __init__(self, model, start, period, harmonics, limits, base_cols,
-                 eps):
+                 eps, clearance=None):
         from ..core.regressor import regressor_batch
         self.regressor_batch = regressor_batch
         self.model = model
@@ -244,6 +303,8 @@ class _Problem:
         self.t_cond = np.linspace(0.0, period, SAMPLES_PER_PERIOD,
                                   endpoint=False)
         self.evaluations = 0
+        self.clearance = clearance
+        self.shrink = 1.0
 
     def coefficients(self, x, fine=False):
         """Scaled (a, b), each (n, K), from the free variables x."""
@@ -260,6 +321,10 @@ class _Problem:
                 self.amax / np.maximum(np.abs(qdd).max(axis=0), 1e-300)]),
                 axis=0)
         s = np.where(np.isfinite(s), s, 0.0)
+        self.shrink = 1.0
+        if self.clearance is not None:
+            self.shrink = self.clearance.shrink(self.start, q * s)
+        s = s * self.shrink
         return a * s[:, None], b * s[:, None]
 
     def log_condition(self, x):
@@ -281,6 +346,14 @@ class _Problem:
         return float(0.5 * np.log(lam[-1] / lam[0]))
 
 
+def _swing_range(limits):
+    """Usable range per joint (a turn at most) that MIN_SWING is of."""
+    rng = np.where(np.isfinite(limits.upper - limits.lower),
+                   (1 - 2 * MARGIN) * (limits.upper - limits.lower),
+                   2 * DEFAULT_HALF_RANGE)
+    return np.minimum(rng, 2 * math.pi)
+
+
 def check_feasible(model, limits, start, period, harmonics):
     """Raise :class:`ExcitationError` when the limits leave no swing."""
     down, up, vmax, amax = _usable(limits, start)
@@ -290,9 +363,7 @@ def check_feasible(model, limits, start, period, harmonics):
             raise ExcitationError(
                 f'start position of {names[j]} ({start[j]:g}) is outside '
                 f'its limits [{limits.lower[j]:g}, {limits.upper[j]:g}]')
-    rng = np.where(np.isfinite(limits.upper - limits.lower),
-                   (1 - 2 * MARGIN) * (limits.upper - limits.lower),
-                   2 * DEFAULT_HALF_RANGE)
+    rng = _swing_range(limits)
     # the fundamental alone, amplitude A: peak speed A w, acceleration A w^2
     w = 2 * math.pi / period
     swing = np.minimum(np.minimum(down, up), np.minimum(vmax / w,
@@ -322,8 +393,15 @@ def check_feasible(model, limits, start, period, harmonics):
 
 
 def excite(model, period=10.0, harmonics=5, seed=0, start=None,
-           budget=TIME_BUDGET, coulomb_width=0.02):
-    """Return the optimised :class:`Excitation` of ``model``."""
+           budget=TIME_BUDGET, coulomb_width=0.02, limits=None,
+           clearance=None):
+    """
+    Return the optimised :class:`Excitation` of ``model``.
+
+    ``limits``: :class:`Limits` (default the model's, see
+    :func:`narrowed`); ``clearance``: an ``ident.clearance.Clearance`` to
+    keep (default none).
+    """
     from scipy.optimize import minimize
     from .base import structural_base
     t0 = time.perf_counter()
@@ -336,7 +414,7 @@ def excite(model, period=10.0, harmonics=5, seed=0, start=None,
         raise ExcitationError(f'--harmonics must be at least 2 (rest at '
                               f'both ends takes two coefficients per '
                               f'joint), got {harmonics}')
-    limits = model_limits(model)
+    limits = model_limits(model) if limits is None else limits
     if start is None:
         mid = 0.5 * (limits.lower + limits.upper)
         start = np.where(np.isfinite(mid), mid, 0.0)
@@ -345,9 +423,11 @@ def excite(model, period=10.0, harmonics=5, seed=0, start=None,
         raise ExcitationError(f'the start configuration needs {model.n} '
                               f'values (one per joint), got {start.size}')
     check_feasible(model, limits, start, period, harmonics)
+    if clearance is not None:
+        clearance.set_start(start)
     base = structural_base(model, drives=True)
     prob = _Problem(model, start, period, harmonics, limits, base.columns,
-                    coulomb_width)
+                    coulomb_width, clearance)
     rng = np.random.default_rng(seed)
     x0 = rng.normal(size=model.n * (2 * harmonics - 2))
     f0 = prob.log_condition(x0)
@@ -380,9 +460,33 @@ def excite(model, period=10.0, harmonics=5, seed=0, start=None,
         condition=float(math.exp(best['f'])),
         condition_random=float(math.exp(f0)), base_count=base.rank,
         seconds=time.perf_counter() - t0, evaluations=prob.evaluations,
-        limits=limits)
+        limits=limits, clearance=clearance, shrink=prob.shrink)
     exc.margins = margins(exc)
+    if clearance is not None:
+        _check_useful(exc, model)
     return exc
+
+
+def _check_useful(exc, model):
+    """Raise ExcitationError if the clearance leaves a joint hardly moving."""
+    swing = np.maximum(exc.margins['q_max'] - exc.start,
+                       exc.start - exc.margins['q_min'])
+    need = 0.5 * MIN_SWING * _swing_range(exc.limits)
+    short = np.flatnonzero(swing < need)
+    if not short.size:
+        return
+    j = int(short[np.argmin(swing[short] / need[short])])
+    cl = exc.clearance
+    slack = cl.slack(exc.sample(np.linspace(0.0, exc.period, 2000))[0])
+    b, p = np.unravel_index(np.argmin(slack), slack.shape)
+    unit = 'm' if model.joint_types[j] == 'prismatic' else 'rad'
+    raise ExcitationError(
+        f'nothing useful fits in the constraints: keeping '
+        f'{cl.bodies[b].name} {cl.required[b, p]:.3g} m from the '
+        f'{cl.planes[p].label} leaves {model.joint_names[j]} a swing '
+        f'of +-{swing[j]:.3g} {unit} (at least +-{need[j]:.3g} is needed; '
+        f'{100 * exc.shrink:.0f} % of the motion the limits allow): start '
+        f'farther from the plane, or narrow the motion with --range')
 
 
 def margins(exc):

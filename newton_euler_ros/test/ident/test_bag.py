@@ -119,13 +119,101 @@ def test_bad_bags_one_line(tmp_path, case, match):
     assert '\n' not in text and str(bag) in text
 
 
+def _synced(path, storage, m, every):
+    """Write as ``newton-euler record`` does: on the disk every few."""
+    from newton_euler_ros.ident.bag import open_writer, sync_writer
+    rng = np.random.default_rng(4)
+    t = 1_700_000_000_000_000_000 + np.arange(m, dtype=np.int64) * 10 ** 7
+    q = rng.normal(size=(m, len(ALL)))
+    writer, conn, ts = open_writer(path, '/joint_states', storage)
+    JointState = ts.types['sensor_msgs/msg/JointState']
+    Header = ts.types['std_msgs/msg/Header']
+    Time = ts.types['builtin_interfaces/msg/Time']
+    for i in range(m):
+        msg = JointState(
+            header=Header(stamp=Time(sec=int(t[i]) // 10 ** 9,
+                                     nanosec=int(t[i]) % 10 ** 9),
+                          frame_id=''),
+            name=list(ALL), position=q[i], velocity=q[i], effort=q[i])
+        writer.write(conn, int(t[i]), ts.serialize_cdr(
+            msg, 'sensor_msgs/msg/JointState'))
+        if (i + 1) % every == 0:
+            sync_writer(writer)
+    writer.close()
+    return t, q
+
+
+def _cut(src, dst, fraction, keep_metadata):
+    import shutil
+    shutil.copytree(src, dst)
+    data = next(p for p in dst.iterdir() if p.suffix in ('.mcap', '.db3'))
+    size = data.stat().st_size
+    with open(data, 'r+b') as fh:
+        fh.truncate(int(size * fraction))
+    if not keep_metadata:
+        (dst / 'metadata.yaml').unlink()
+
+
 @pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
-def test_truncated_file(tmp_path, storage):
+@pytest.mark.parametrize('writer', ['one chunk', 'synced'])
+def test_a_damaged_bag_reads_as_a_prefix(tmp_path, capsys, storage, writer):
+    """
+    Cut short (mid-chunk too) and without metadata.yaml: a prefix.
+
+    The messages read equal the first ones written, as many as the
+    bytes left hold (within the storage's overhead), and one line on
+    stderr says how many were recovered.
+    """
+    m = 3000
+    src = tmp_path / 'rec'
+    if writer == 'synced':
+        # many small MCAP chunks / sqlite3 transactions, as record writes
+        t, q = _synced(src, storage, m, every=137)
+    else:
+        t, q, _, _ = _record(src, storage, m=m)
+        q = q[:, [ALL.index(j) for j in ALL]]
+    capsys.readouterr()
+    cols = [ALL.index(j) for j in CHAIN]
+    for i, (fraction, keep) in enumerate([
+            (1.0, False), (0.93, True), (0.71, False), (0.5, True),
+            (0.377, False), (0.2, False)]):
+        bag = tmp_path / f'cut{i}'
+        _cut(src, bag, fraction, keep)
+        js = read_joint_states(bag, CHAIN, min_samples=1)
+        k = len(js)
+        assert (1.0 if fraction == 1.0 else fraction - 0.12) * m <= k <= m, \
+            (fraction, k)
+        np.testing.assert_array_equal(js.stamps_ns, t[:k])
+        np.testing.assert_array_equal(js.q, q[:k][:, cols])
+        lines = capsys.readouterr().err.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith(
+            f'warning: recording {bag}: ') and \
+            f'recovered {k} messages on /joint_states' in lines[0], lines
+        assert ('no metadata.yaml' in lines[0]) == (not keep)
+        assert ('cut short' in lines[0]) == (fraction < 1.0)
+
+
+@pytest.mark.parametrize('storage', ['mcap', 'sqlite3'])
+def test_what_cannot_be_recovered_stays_an_error(tmp_path, storage):
     bag = tmp_path / 'rec'
-    _record(bag, storage, m=400)
-    data = next(p for p in bag.iterdir() if p.suffix in ('.mcap', '.db3'))
-    raw = data.read_bytes()
-    data.write_bytes(raw[:len(raw) // 2])
-    with pytest.raises(BagError) as info:
-        read_joint_states(bag, CHAIN)
-    assert str(bag) in str(info.value) and '\n' not in str(info.value)
+    _record(bag, storage, m=300)
+    # cut before any message: nothing to recover
+    empty = tmp_path / 'empty'
+    _cut(bag, empty, 0.002, False)
+    with pytest.raises(BagError, match='nothing can be recovered') \
+            as info:
+        read_joint_states(empty, CHAIN)
+    assert str(empty) in str(info.value) and '\n' not in str(info.value)
+    # a damaged bag without the topic: the same error as an intact one
+    cut = tmp_path / 'cut'
+    _cut(bag, cut, 0.6, False)
+    with pytest.raises(BagError, match="no topic '/other'"):
+        read_joint_states(cut, CHAIN, topic='/other')
+    # a storage file that is not one
+    junk = tmp_path / 'junk'
+    junk.mkdir()
+    (junk / f'junk.{"mcap" if storage == "mcap" else "db3"}').write_bytes(
+        b'\x00' * 4096)
+    with pytest.raises(BagError, match='cannot be recovered') as info:
+        read_joint_states(junk, CHAIN)
+    assert '\n' not in str(info.value)

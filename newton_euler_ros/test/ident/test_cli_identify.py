@@ -187,7 +187,6 @@ def bad_case(case, tmp_path, example, panda):
 
 
 BAD = [('missing', 'no such bag'), ('corrupt', 'cannot open'),
-       ('truncated', ''), ('truncated_mcap', ''),
        ('topic', "no topic '/arm/joint_states'"), ('effort', 'no effort'),
        ('joint', 'panda_joint7'), ('short', 'too short'),
        ('still', 'does not excite'), ('urdf', 'no such URDF')]
@@ -211,6 +210,20 @@ def test_bad_input_is_one_line_exit_2(case, words, tmp_path, example,
         assert code == 2
         assert words in one_line_error(err, *names)
         assert not csv_path.exists()
+
+
+@pytest.mark.parametrize('case', ['truncated', 'truncated_mcap'])
+def test_a_truncated_bag_is_identified_up_to_the_cut(case, tmp_path,
+                                                     example, panda):
+    # a third of the file: read up to its last intact message, and said
+    args, _ = bad_case(case, tmp_path, example, panda)
+    out = tmp_path / 'out.urdf'
+    code, stdout, err = run('identify', *args[:2], *CHAIN, '-o', out)
+    assert code == 0, err
+    said = [x for x in err.splitlines() if 'recovered' in x]
+    assert len(said) == 1 and said[0].startswith(
+        f'warning: recording {args[1]}: ') and 'cut short' in said[0], err
+    assert out.exists()
 
 
 def test_validate_bag_errors_name_it(example, tmp_path):

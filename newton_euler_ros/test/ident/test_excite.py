@@ -29,6 +29,9 @@ from newton_euler_tools.ident_example import BASE, panda_path, TIP
 import numpy as np
 import pytest
 
+# the Panda's ready pose: where excite starts (the arm's pose now)
+START = ['--start', '0', '-0.785', '0', '-2.356', '0', '1.571', '0.785']
+
 
 def run_cli(*args):
     proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
@@ -120,7 +123,8 @@ def test_period_too_short_is_refused(panda):
 def test_cli_writes_what_feedforward_reads(tmp_path):
     out = tmp_path / 'excite.json'
     code, text, err = run_cli('excite', panda_path(), '--base', BASE,
-                              '--tip', TIP, '-o', str(out), '--period', '6',
+                              '--tip', TIP, '-o', str(out), *START,
+                              '--period', '6',
                               '--harmonics', '3', '--seconds', '12',
                               '--budget', '3')
     assert code == 0, err
@@ -149,7 +153,7 @@ def test_cli_bad_requests_one_line_exit_2(tmp_path, args, words):
     out = tmp_path / 'x.json'
     code, text, err = run_cli('excite', panda_path(), '--base', BASE,
                               '--tip', TIP, '-o', str(out), '--budget', '1',
-                              *args)
+                              *START, *args)
     assert code == 2, (text, err)
     lines = [x for x in err.splitlines() if not x.startswith(('note',
                                                               'warning'))]
@@ -160,10 +164,12 @@ def test_cli_bad_requests_one_line_exit_2(tmp_path, args, words):
 
 def test_cli_missing_urdf_and_directory(tmp_path):
     code, _, err = run_cli('excite', str(tmp_path / 'no.urdf'), '--base',
-                           BASE, '--tip', TIP, '-o', str(tmp_path / 'x.json'))
+                           BASE, '--tip', TIP, '-o', str(tmp_path / 'x.json'),
+                           *START)
     assert code == 2 and 'no.urdf' in err and len(err.splitlines()) == 1
     code, _, err = run_cli('excite', panda_path(), '--base', BASE, '--tip',
-                           TIP, '-o', str(tmp_path / 'nodir' / 'x.json'))
+                           TIP, '-o', str(tmp_path / 'nodir' / 'x.json'),
+                           *START)
     assert code == 2 and 'nodir' in err and len(err.splitlines()) == 1
 
 

@@ -44,6 +44,8 @@ MOVE = os.path.join(PACKAGE_DIR, 'config', 'trajectories',
                     'puma560_move.json')
 TRAJ_TOPIC = '/exit_status/trajectory'
 STATE_TOPIC = '/exit_status/joint_states'
+# excite starts where the arm is: the Panda's ready pose
+START = ['--start', '0', '-0.785', '0', '-2.356', '0', '1.571', '0.785']
 
 
 def commands():
@@ -84,8 +86,8 @@ CASES = {
                  ['{missing}']),
     'robots': ([], None),
     'excite': (['{urdf}', *CHAIN, '-o', '{out}.json', '--budget', '1',
-                '--period', '4', '--harmonics', '2'],
-               ['{missing}', *CHAIN, '-o', '{out}.json']),
+                '--period', '4', '--harmonics', '2', *START],
+               ['{missing}', *CHAIN, '-o', '{out}.json', *START]),
     'identify': (['{urdf}', '{bag}', *CHAIN, '-o', '{out}.urdf'],
                  ['{urdf}', '{missing}', *CHAIN, '-o', '{out}.urdf']),
     'replay': (['{urdf}', '{bag}', *CHAIN, '--csv', '{out}.csv'],
@@ -94,7 +96,8 @@ CASES = {
                 ['{urdf}', '{missing}', *CHAIN]),
     'observe': (['{urdf}', '{bag}', *CHAIN, '--csv', '{out}.csv'],
                 ['{urdf}', '{missing}', *CHAIN, '--csv', '{out}.csv']),
-    'send': ([MOVE, '--topic', TRAJ_TOPIC, '--no-follow', '--wait', '60'],
+    'send': ([MOVE, '--topic', TRAJ_TOPIC, '--no-follow', '--wait', '60',
+              '--joint-states', STATE_TOPIC],
              ['{missing}', '--topic', TRAJ_TOPIC]),
     'record': (['{out}', '--topic', STATE_TOPIC, '--max-messages', '3',
                 '--wait', '60'],
@@ -107,7 +110,8 @@ SILENT_GRAPH = {
 }
 # interrupted while working: exit status 130
 LONG_RUNNING = {
-    'excite': ['{urdf}', *CHAIN, '-o', '{out}.json', '--budget', '600'],
+    'excite': ['{urdf}', *CHAIN, '-o', '{out}.json', '--budget', '600',
+               *START],
     'simulate': ['puma_payload_press', '--duration', '100000'],
     'send': [MOVE, '--topic', '/exit_status/nobody', '--wait', '600'],
 }
@@ -124,14 +128,19 @@ def test_every_command_has_cases():
 
 def beside_the_graph(command, args):
     """Run send or record while a probe subscribes or publishes."""
+    import json
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory
     probe = Probe(DOMAIN, name='exit_status_probe')
     try:
+        pub = probe.publisher(JointState, STATE_TOPIC)
         if command == 'send':
             got = probe.collect(JointTrajectory, TRAJ_TOPIC)
-        else:
-            pub = probe.publisher(JointState, STATE_TOPIC)
+            # the robot at the trajectory's first point
+            with open(MOVE, encoding='utf-8') as fh:
+                move = json.load(fh)
+            at_start = JointState(name=move['joint_names'],
+                                  position=move['points'][0]['positions'])
         proc = subprocess.Popen([exe(), command, *args],
                                 stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True,
@@ -146,6 +155,8 @@ def beside_the_graph(command, args):
                 msg.header.stamp.sec, msg.header.stamp.nanosec = divmod(
                     stamp, 10 ** 9)
                 pub.publish(msg)
+            else:
+                pub.publish(at_start)
             probe.spin_for(0.01)
         out, err = proc.communicate(timeout=30)
         if command == 'send':

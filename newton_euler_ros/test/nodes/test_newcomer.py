@@ -76,7 +76,8 @@ def files(tmp_path_factory):
 @pytest.mark.parametrize('command', [
     ['check', '{xacro}'], ['dynamics', '{xacro}', '--q', '0'],
     ['urdf', '{xacro}'],
-    ['excite', '{xacro}', '--base', 'a', '--tip', 'b', '-o', 'x.json'],
+    ['excite', '{xacro}', '--base', 'a', '--tip', 'b', '--start', '0',
+     '-o', 'x.json'],
 ])
 def test_cli_says_expand_the_xacro_first(command, files, tmp_path):
     args = [a.format(**files) for a in command]

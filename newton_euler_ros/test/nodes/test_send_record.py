@@ -249,3 +249,103 @@ def test_record_adapts_to_a_best_effort_driver(tmp_path):
         in refused.stderr
     assert not (tmp_path / 'wrong').exists()
     del wrong
+
+
+def _write(path, points):
+    path.write_text(json.dumps({'joint_names': NAMES, 'points': points}))
+    return path
+
+
+def test_send_checks_the_start_and_moves_there_slowly(tmp_path):
+    """Refused off the start (offsets in one line); --move-to-start goes."""
+    import re
+    from sensor_msgs.msg import JointState
+    from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
+    from newton_euler_ros.sim.scene import scene_dirs
+    domain = domain_id(17)
+    bundled = next(path for path in (
+        os.path.join(d, 'puma_pick_and_place.yaml') for d in scene_dirs())
+        if os.path.isfile(path))
+    with open(bundled, encoding='utf-8') as fh:
+        scene = fh.read().replace('duration: 5.0', 'duration: 120.0')
+    (tmp_path / 'scene.yaml').write_text(scene)
+    sim = NodeProcess([os.path.join(os.path.dirname(sys.executable),
+                                    'robot_sim_node'), '--ros-args',
+                       '-p', f'scene:={tmp_path / "scene.yaml"}',
+                       '-p', 'wait_for_subscribers:=2'],
+                      domain, str(tmp_path / 'sim.log'))
+    node = NodeProcess(id_node_cmd(None, '-p', 'robot_file:=puma560',
+                                   '-p', 'mode:=gravity', '-r',
+                                   '~/trajectory_out:=/robot_sim_node/'
+                                   'joint_trajectory'),
+                       domain, str(tmp_path / 'node.log'))
+    probe = Probe(domain, name='start_check_probe')
+    live = probe.collect(JointState, 'joint_states')
+    to_robot = probe.collect(JointTrajectory, '/robot_sim_node/'
+                             'joint_trajectory')
+    offset = np.array([0.25, 0.0, -0.15, 0.0, 0.0, 0.0])
+    start = np.array(Q0) + offset
+    away = [{'time_from_start': t,
+             'positions': list(start + STEP * t / MOVE)}
+            for t in np.arange(0.0, MOVE + 1e-9, 0.05)]
+    off = _write(tmp_path / 'off.json', away)
+    hold = _write(tmp_path / 'hold.json', [
+        {'time_from_start': t, 'positions': list(Q0)} for t in (0.0, 1.0)])
+    hold_now = probe.node.create_publisher(
+        JointTrajectory, '/inverse_dynamics_node/trajectory_in', 10)
+    try:
+        assert probe.spin_until(lambda: live, 90.0), sim.log() + node.log()
+        # the robot holds Q0 at once (the simulator holds t = 0 only until
+        # its first command): stamped on the simulator's own timeline
+        first = JointTrajectory(joint_names=NAMES)
+        first.header.stamp = live[-1].header.stamp
+        first.points = [JointTrajectoryPoint(positions=Q0,
+                                             velocities=[0.0] * 6)]
+        hold_now.publish(first)
+        assert probe.spin_until(lambda: len(to_robot) == 1, 10.0)
+        # at the start: sent
+        held = cli('send', str(hold), '--start-in', '0', '--wait', '60',
+                   domain=domain, timeout=120)
+        assert held.returncode == 0, held.stdout + held.stderr
+        assert "at the trajectory's first point" in held.stdout
+        assert probe.spin_until(lambda: len(to_robot) == 2, 10.0)
+        # off the start: refused, each joint's offset in one line, and
+        # nothing reaches the robot
+        refused = cli('send', str(off), '--start-in', '0', '--wait', '30',
+                      domain=domain, timeout=120)
+        # the inputs are good, the robot is elsewhere: status 1
+        assert refused.returncode == 1, refused.stdout + refused.stderr
+        lines = refused.stderr.strip().splitlines()
+        assert len(lines) == 1 and 'not at the trajectory' in lines[0] \
+            and '--move-to-start' in lines[0], refused.stderr
+        said = dict(re.findall(r'(joint\d) ([+-]\d+\.\d+)', lines[0]))
+        assert sorted(said) == NAMES, lines[0]
+        np.testing.assert_allclose([float(said[n]) for n in NAMES],
+                                   -offset, atol=0.01)
+        probe.spin_for(1.0)
+        assert len(to_robot) == 2
+        # --move-to-start: a slow move there, checked, then the trajectory
+        moved = cli('send', str(off), '--start-in', '0', '--wait', '30',
+                    '--move-to-start', '--move-speed', '0.3',
+                    domain=domain, timeout=120)
+        assert moved.returncode == 0, moved.stdout + moved.stderr
+        assert 'moving to the start at 0.3 rad/s' in moved.stdout
+        assert 'trajectory ended' in moved.stdout
+        assert probe.spin_until(lambda: len(to_robot) == 4, 10.0), \
+            len(to_robot)
+        # the move: rest to rest, from where the robot was, at 0.3 rad/s
+        move = to_robot[2]
+        first = np.array(move.points[0].positions)
+        np.testing.assert_allclose(first, Q0, atol=0.01)
+        np.testing.assert_allclose(move.points[-1].positions, start,
+                                   atol=1e-12)
+        peak = max(max(abs(v) for v in p.velocities) for p in move.points)
+        assert 0.25 < peak <= 0.3 + 1e-9
+        goal = start + STEP
+        assert probe.spin_until(lambda: np.abs(
+            np.array(live[-1].position) - goal).max() < 0.01, 20.0), \
+            np.array(live[-1].position) - goal
+    finally:
+        probe.close()
+        status = [node.stop(), sim.stop()]
+    assert status == [0, 0], node.log() + sim.log()
