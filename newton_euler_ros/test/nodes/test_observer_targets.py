@@ -49,8 +49,6 @@ from newton_euler_ros.ident.bag import read_joint_states
 import numpy as np
 import pytest
 
-pytest.importorskip('rosbags')
-pytest.importorskip('pinocchio')
 
 SEED = 0
 CHAIN = ['--base', 'base_link', '--tip', 'tool0']

@@ -295,6 +295,12 @@ def test_send_checks_the_start_and_moves_there_slowly(tmp_path):
         JointTrajectory, '/inverse_dynamics_node/trajectory_in', 10)
     try:
         assert probe.spin_until(lambda: live, 90.0), sim.log() + node.log()
+        # the node's trajectory input and output both matched with the
+        # probe, or the first command may be published to nobody
+        assert probe.spin_until(
+            lambda: hold_now.get_subscription_count() >= 1
+            and probe.node.count_publishers(
+                '/robot_sim_node/joint_trajectory') >= 1, 90.0), node.log()
         # the robot holds Q0 at once (the simulator holds t = 0 only until
         # its first command): stamped on the simulator's own timeline
         first = JointTrajectory(joint_names=NAMES)
