@@ -19,18 +19,11 @@ The parameters theta = [pi (10n, per link), drives (4n, per joint)] enter
 the torques linearly, tau = Y theta (``core.regressor`` with
 ``drives=True``).  The pipeline:
 
-1. Stream the bag in chunks (``bag.iter_joint_states``), prepare windows
-   of it (``signals.prepare``: resample, zero-phase filter, differentiate,
-   same filter on the effort, edges dropped; windows overlap by the
-   filter's edge so nothing is lost between them), keep every k-th sample
-   so that the fit rate is about ``FIT_RATE_FACTOR`` times the cutoff
-   (the filtered signals carry nothing above the cutoff).
-2. Accumulate, per joint j, the R factor of the augmented matrix
-   [Y_j | y_j] over the chunks (:class:`Reduced`): (14n + 1)^2 numbers
-   whatever the recording's length, and from it exactly the residual
-   ||y_j - Y_j theta||^2 of any theta.  Time blocks of ``BLOCK_S`` seconds
-   (shorter for a short recording) alternate between a training and a
-   held-out part (one in ``HOLDOUT_EVERY``).
+1-2. Read, prepare and reduce the recording (``reduce``): per joint j,
+   the R factor of [Y_j | y_j] over the filtered, decimated samples,
+   (14n + 1)^2 numbers whatever the recording's length, from which the
+   residual ||y_j - Y_j theta||^2 of any theta follows exactly; a
+   training part and held-out time blocks.
 3. Weights: each joint's rows by 1 / sigma_j, sigma_j the RMS residual of
    an unconstrained least-squares fit on the training part (weighted least
    squares, Gautier & Poignet): small wrist torques count as much as the
@@ -60,191 +53,37 @@ import time
 
 import numpy as np
 
-from .bag import (BagError, DEFAULT_TOPIC, iter_joint_states,
-                  recording_seconds)
+from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
-from .signals import default_cutoff, edge_samples, prepare, sample_rate
+from .reduce import IdentificationError, reduce_recording  # noqa: F401
 from ..core.drives import DEFAULT_COULOMB_WIDTH, Drives, model_drives
 from ..core.regressor import (inertial_parameters, N_DRIVE, N_INERTIAL,
                               regressor_batch, with_parameters)
 
-BLOCK_S = 4.0
-HOLDOUT_EVERY = 5
-FIT_RATE_FACTOR = 10.0
 LAMBDAS = tuple(10.0 ** k for k in range(-8, 1))
 LAMBDA_SLACK = 0.02
 # a recording whose rank is below this fraction of the structural count
 # does not excite the arm
 MIN_RANK_FRACTION = 0.5
-STATE_CHUNK = 4096
-READ_CHUNK = 32768
-
-
-class IdentificationError(BagError):
-    """The recording cannot give a model (one line naming the bag)."""
-
-
-class Reduced:
-    """
-    Per joint, the R factor of [Y_j | y_j] accumulated over chunks.
-
-    ``R[j]`` is (at most) (p + 1) x (p + 1) upper triangular; the residual
-    of any theta on joint j's rows is ||R[j] [theta; -1]||, and the
-    effort's squared norm is ||R[j][:, p]||^2.
-    """
-
-    def __init__(self, n, p):
-        self.n = n
-        self.p = p
-        self.R = [np.zeros((0, p + 1)) for _ in range(n)]
-        self.rows = np.zeros(n, dtype=np.int64)
-
-    def add(self, Y, tau):
-        """Add (m, n, p) regressor rows and (m, n) torques."""
-        m = Y.shape[0]
-        if m == 0:
-            return
-        for j in range(self.n):
-            A = np.empty((m + self.R[j].shape[0], self.p + 1))
-            A[:m, :self.p] = Y[:, j, :]
-            A[:m, self.p] = tau[:, j]
-            A[m:] = self.R[j]
-            self.R[j] = np.linalg.qr(A, mode='r')
-        self.rows += m
-
-    def merged(self, other):
-        """Return the reduction of both sets of rows."""
-        out = Reduced(self.n, self.p)
-        for j in range(self.n):
-            out.R[j] = np.linalg.qr(np.vstack([self.R[j], other.R[j]]),
-                                    mode='r')
-        out.rows = self.rows + other.rows
-        return out
-
-    def sq_residuals(self, theta):
-        """(n,) squared residual norms of theta, per joint."""
-        x = np.append(theta, -1.0)
-        return np.array([float(np.sum((Rj @ x) ** 2)) for Rj in self.R])
-
-    def sq_effort(self):
-        """(n,) squared norms of the measured torques, per joint."""
-        return np.array([float(np.sum(Rj[:, self.p] ** 2))
-                         for Rj in self.R])
-
-    def stats(self, theta):
-        """Return (rms, relative rms) per joint of the residual of theta."""
-        rows = np.maximum(self.rows, 1)
-        rms = np.sqrt(self.sq_residuals(theta) / rows)
-        ref = np.sqrt(self.sq_effort() / rows)
-        return rms, rms / np.maximum(ref, 1e-300)
-
-    def stacked(self, weights):
-        """Weighted [Y | y] rows of all joints (reduced), (<= n(p+1), p+1)."""
-        return np.vstack([Rj * w for Rj, w in zip(self.R, weights)])
-
-
-# ---------------------------------------------------------------------------
-# from the bag to reduced problems
-
-def prepared_windows(path, joint_names, topic=DEFAULT_TOPIC, cutoff=None,
-                     window=READ_CHUNK):
-    """
-    Yield ``signals.Prepared`` windows of the recording, in order.
-
-    Windows overlap by twice the filter's edge in raw samples, and the
-    samples of a window at or before the last one yielded are dropped, so
-    the windows tile the recording once.
-    """
-    tail = None
-    rate = None
-    last_t = -np.inf
-    for chunk in iter_joint_states(path, joint_names, topic, chunk=window):
-        parts = [chunk] if tail is None else [tail, chunk]
-        stamps = np.concatenate([p.stamps for p in parts])
-        q = np.concatenate([p.q for p in parts])
-        qd = None if any(p.qd is None for p in parts) else np.concatenate(
-            [p.qd for p in parts])
-        e = np.concatenate([p.effort for p in parts])
-        if rate is None:
-            rate = sample_rate(stamps)
-            cutoff = default_cutoff(rate) if cutoff is None else cutoff
-            edge = edge_samples(rate, cutoff)
-        piece = prepare(stamps, q, qd, e, rate=rate, cutoff=cutoff,
-                        edge=edge)
-        keep = 2 * edge + 4
-        tail = _Tail(stamps[-keep:], q[-keep:],
-                     None if qd is None else qd[-keep:], e[-keep:])
-        if piece is None:
-            continue
-        new = piece.t > last_t + 0.5 / rate
-        if not new.any():
-            continue
-        last_t = piece.t[new][-1]
-        for key in ('t', 'q', 'qd', 'qdd', 'effort'):
-            setattr(piece, key, getattr(piece, key)[new])
-        yield piece
-
-
-@dataclass
-class _Tail:
-    stamps: np.ndarray
-    q: np.ndarray
-    qd: object
-    effort: np.ndarray
-
-
-def _decimation(rate, cutoff):
-    return max(1, int(rate / (FIT_RATE_FACTOR * cutoff)))
 
 
 def accumulate(model, path, topic=DEFAULT_TOPIC, coulomb_width=None,
                cutoff=None, split=True):
     """
-    Reduce a recording: return (train, held_out or None, info dict).
+    Reduce a recording to the regressor's problem (``reduce``).
 
-    With ``split=False`` every block goes to ``train``.  Blocks are
-    ``BLOCK_S`` long, shorter for a recording under ten blocks (down to
-    half a second), so that even a short one has a held-out part.
+    Return (train, held_out or None, info dict): the rows of the torque
+    regressor with drive terms (Coulomb width ``coulomb_width``) against
+    the effort.
     """
-    block_s = BLOCK_S
-    if split:
-        block_s = min(BLOCK_S, max(0.5, recording_seconds(path) / 10.0))
     eps = DEFAULT_COULOMB_WIDTH if coulomb_width is None else coulomb_width
-    p = model.n * (N_INERTIAL + N_DRIVE)
-    train = Reduced(model.n, p)
-    held = Reduced(model.n, p) if split else None
-    samples = 0
-    info = {'rate': None, 'cutoff': None, 'duration': 0.0}
-    t_first = None
-    for piece in prepared_windows(path, model.joint_names, topic, cutoff):
-        if info['rate'] is None:
-            info['rate'], info['cutoff'] = piece.rate, piece.cutoff
-            step = _decimation(piece.rate, piece.cutoff)
-            info['step'] = step
-        if t_first is None:
-            t_first = piece.t[0]
-        info['duration'] = piece.t[-1] - t_first
-        idx = np.arange(0, len(piece), step)
-        samples += len(piece)
-        for a in range(0, len(idx), STATE_CHUNK):
-            sel = idx[a:a + STATE_CHUNK]
-            Y = regressor_batch(model, piece.q[sel], piece.qd[sel],
-                                piece.qdd[sel], drives=True,
-                                coulomb_width=eps)
-            tau = piece.effort[sel]
-            if held is None:
-                train.add(Y, tau)
-                continue
-            block = np.floor((piece.t[sel] - t_first) / block_s)
-            out = (block % HOLDOUT_EVERY) == HOLDOUT_EVERY - 1
-            train.add(Y[~out], tau[~out])
-            held.add(Y[out], tau[out])
-    info['samples'] = samples
-    if samples == 0:
-        raise IdentificationError(
-            f'{path}: too short: nothing is left after filtering (needs '
-            f'more than a few tenths of a second of samples without gaps)')
-    return train, held, info
+
+    def rows(q, qd, qdd, effort):
+        return regressor_batch(model, q, qd, qdd, drives=True,
+                               coulomb_width=eps), effort
+    return reduce_recording(path, model.joint_names, rows,
+                            model.n * (N_INERTIAL + N_DRIVE), topic, cutoff,
+                            split)
 
 
 # ---------------------------------------------------------------------------

@@ -29,9 +29,9 @@ X J X^T with X the 4x4 pose of the tip in the link frame, which is the
 model's ``tool``).  ``pi_p`` = (m, m c, I about the tip origin) in the tip
 frame.
 
-The samples come from the identification pipeline (``fit.prepared_windows``:
-resampled, zero-phase filtered, same filter on the effort), reduced to a
-10 x 10 R factor per joint.  Each joint is weighted by 1 / its residual RMS
+The samples come from the identification pipeline (``reduce``:
+resampled, zero-phase filtered, same filter on the effort), reduced to an
+11 x 11 R factor per joint.  Each joint is weighted by 1 / its residual RMS
 (unconstrained fit first), and the fit is a small semidefinite program:
 the payload's pseudo-inertia positive semi-definite (so m >= 0 and the
 inertia physical), with a tiny pull toward zero so that directions the
@@ -50,7 +50,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fit import _decimation, IdentificationError, prepared_windows, Reduced
+from .reduce import IdentificationError, reduce_recording
 from ..core.drives import model_drives
 from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
                               regressor_batch)
@@ -62,7 +62,6 @@ COM_TOL = 0.01            # m, standard error of each coordinate
 INERTIA_TOL = 0.3         # relative standard error
 INERTIA_ABS = 2e-3        # kg m^2
 PRIOR_WEIGHT = 1e-6       # pull toward zero, of the data's scale
-STATE_CHUNK = 4096
 INERTIA_KEYS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 INERTIA_NAMES = ('Ixx', 'Iyy', 'Izz', 'Ixy', 'Iyz', 'Ixz')
 
@@ -200,36 +199,19 @@ def _clip_psd(pi):
 
 def estimate_payload(model, path, topic='/joint_states', cutoff=None):
     """Return a :class:`PayloadEstimate` from the bag at ``path``."""
+    from ..core import inverse_dynamics_batch
     n = model.n
     drives = model_drives(model)
     T = tip_to_link(model.tool)
-    red = Reduced(n, N_INERTIAL)
-    before = Reduced(n, 0)
-    samples = 0
-    t_first = None
-    duration = 0.0
-    from ..core import inverse_dynamics_batch
-    for piece in prepared_windows(path, model.joint_names, topic, cutoff):
-        step = _decimation(piece.rate, piece.cutoff)
-        idx = np.arange(0, len(piece), step)
-        if t_first is None:
-            t_first = piece.t[0]
-        duration = piece.t[-1] - t_first
-        samples += len(piece)
-        for a in range(0, len(idx), STATE_CHUNK):
-            sel = idx[a:a + STATE_CHUNK]
-            q, qd, qdd = piece.q[sel], piece.qd[sel], piece.qdd[sel]
-            tau = inverse_dynamics_batch(model, q, qd, qdd)
-            if drives is not None:
-                tau = tau + drives.torques(qd, qdd)
-            rest = piece.effort[sel] - tau
-            Y = regressor_batch(model, q, qd, qdd)[
-                :, :, N_INERTIAL * (n - 1):]
-            red.add(Y @ T, rest)
-            before.add(np.zeros((len(sel), n, 0)), rest)
-    if samples == 0:
-        raise IdentificationError(
-            f'{path}: too short: nothing is left after filtering')
+
+    def rows(q, qd, qdd, effort):
+        tau = inverse_dynamics_batch(model, q, qd, qdd)
+        if drives is not None:
+            tau = tau + drives.torques(qd, qdd)
+        Y = regressor_batch(model, q, qd, qdd)[:, :, N_INERTIAL * (n - 1):]
+        return Y @ T, effort - tau
+    red, _, info = reduce_recording(path, model.joint_names, rows,
+                                    N_INERTIAL, topic, cutoff, split=False)
     rows = np.maximum(red.rows, 1)
     A = red.stacked(np.ones(n))
     theta, *_ = np.linalg.lstsq(A[:, :-1], A[:, -1], rcond=1e-12)
@@ -271,9 +253,9 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None):
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 1e30)
     cov = (Vt.T * inv_s2) @ Vt / np.outer(Ds, Ds) * res_w ** 2
     est = _uncertainty(m, c, Ic, pi, cov)
-    est.samples = samples
-    est.duration = duration
-    est.residual_before = np.sqrt(before.sq_effort() / rows)
+    est.samples = info['samples']
+    est.duration = info['duration']
+    est.residual_before = np.sqrt(red.sq_effort() / rows)
     est.residual_after = np.sqrt(red.sq_residuals(pi) / rows)
     est.joint_names = list(model.joint_names)
     return est
