@@ -76,10 +76,27 @@ def _short(text, limit=MAX_NAME):
 
 
 class _Source:
-    """The origin of a URDF (for messages) and its parse tree."""
+    """
+    The origin of a URDF (for messages) and how strictly it is read.
 
-    def __init__(self, label):
+    ``prior``: the file is the prior of an identification, which makes
+    every link physical anyway: physically impossible values (a negative
+    mass or principal moment, negative friction) are accepted, each with
+    a Note appended to ``notes``.
+    """
+
+    def __init__(self, label, prior=False, notes=None):
         self.label = label
+        self.prior = prior
+        self.notes = [] if notes is None else notes
+
+    def accept(self, where, message):
+        """Note an impossible value of a prior; raise for anything else."""
+        if not self.prior:
+            raise self.error(where, message)
+        self.notes.append(Note(f'{self.label}: {where}: {message}; accepted '
+                               f'as the prior of an identification (the fit '
+                               f'makes it physical)'))
 
     def error(self, where, message):
         return RobotFileError(f'{self.label}: {where}: {message}')
@@ -234,7 +251,7 @@ def _read_inertial(link, el, src):
         raise src.error(where, 'missing <mass>')
     mass = _numbers(mass_el, 'value', 1, f'{where}<mass>', src)[0]
     if mass < 0.0:
-        raise src.error(f'{where}<mass> value', f'must be >= 0, got {mass}')
+        src.accept(f'{where}<mass> value', f'must be >= 0, got {mass}')
     in_el = inertial.find('inertia')
     if in_el is None:
         raise src.error(where, 'missing <inertia>')
@@ -246,8 +263,8 @@ def _read_inertial(link, el, src):
                         [vals['ixz'], vals['iyz'], vals['izz']]])
     eig, valid = principal_moments(inertia)
     if not valid:
-        raise src.error(f'{where}<inertia>', 'not positive semi-definite '
-                        f'(principal moments {format_moments(eig)})')
+        src.accept(f'{where}<inertia>', 'not positive semi-definite '
+                   f'(principal moments {format_moments(eig)})')
     R = rpy_matrix(*rpy)
     link.mass = mass
     link.com = np.array(xyz)
@@ -310,9 +327,14 @@ def _read_joint(el, index, src, links):
     return joint
 
 
-def parse_urdf(text, label='robot_description'):
-    """Parse and check URDF text; return (name, links, joints) dicts."""
-    src = _Source(label)
+def parse_urdf(text, label='robot_description', prior=False, notes=None):
+    """
+    Parse and check URDF text; return (name, root, links, joints).
+
+    ``prior=True`` reads the prior of an identification: physically
+    impossible inertials are accepted, with a Note appended to ``notes``.
+    """
+    src = _Source(label, prior, notes)
     root = _parse(text, src)
     name = root.get('name') or 'robot'
     link_els = root.findall('link')
@@ -491,15 +513,19 @@ def _chain_limits(joints, moving):
 
 
 def urdf_model(text, label='robot_description', base=None, tip=None,
-               gravity=(0.0, 0.0, -9.81)):
+               gravity=(0.0, 0.0, -9.81), prior=False):
     """
     Build the chain model of URDF text; return (model, warnings, report).
 
     ``report`` describes what was made of the tree: the chain's links and
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
+    ``prior=True``: the file is the prior of an identification, read
+    leniently (:func:`parse_urdf`; negative friction too), each impossible
+    value a Note among the warnings.  Nothing else reads that way.
     """
-    name, root, links, joints = parse_urdf(text, label)
+    notes = []
+    name, root, links, joints = parse_urdf(text, label, prior, notes)
     base, tip, chain = chain_ends(label, links, joints, root, base, tip)
     moving = _moving_joints(label, joints, chain, base, tip)
     pre, merged, tool = _placements(joints, chain, moving)
@@ -523,15 +549,17 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
         info={'source': label, 'urdf': report,
               # friction, offset, rotor inertia (or None)
               'drives': read_drives(_parse(text, _Source(label)), moving,
-                                    label)})
-    return model, _tree_warnings(label, links, joints, bodies), report
+                                    label, prior, notes)})
+    return (model, notes + _tree_warnings(label, links, joints, bodies),
+            report)
 
 
 def inspect_urdf(text_or_path, base=None, tip=None, label=None,
-                 gravity=(0.0, 0.0, -9.81)):
+                 gravity=(0.0, 0.0, -9.81), prior=False):
     """Load a URDF (text or path); return (model, warnings, report)."""
     text, label = read_urdf_text(text_or_path, label)
-    return urdf_model(text, label, base=base, tip=tip, gravity=gravity)
+    return urdf_model(text, label, base=base, tip=tip, gravity=gravity,
+                      prior=prior)
 
 
 def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):

@@ -19,7 +19,10 @@ The arm's model (identified inertials and drive terms) predicts what the
 drives need without the payload; the rest of the measured effort is the
 payload's:
 
-    effort - tau_arm(q, qd, qdd) - tau_drives(qd, qdd) = Y_tip T pi_p
+    K effort - tau_arm(q, qd, qdd) - tau_drives(qd, qdd) = Y_tip T pi_p
+
+with K the URDF's torque constants when the efforts are motor currents
+(``core.drives``: ``torque_constant``; 1 for torques).
 
 ``Y_tip`` is the last link's ten columns of the torque regressor
 (``core.regressor``: parameters about the last link frame's origin, in its
@@ -208,6 +211,8 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None):
         tau = inverse_dynamics_batch(model, q, qd, qdd)
         if drives is not None:
             tau = tau + drives.torques(qd, qdd)
+            # a motor current's torque: the torque constants of the URDF
+            effort = drives.effort_to_torque(effort)
         Y = regressor_batch(model, q, qd, qdd)[:, :, N_INERTIAL * (n - 1):]
         return Y @ T, effort - tau
     red, _, info = reduce_recording(path, model.joint_names, rows,
