@@ -215,10 +215,10 @@ def _print_constants(result, names):
         print(f'  {name:<24}{K[j]:>10.4g}{tag}')
     if result.payload is not None:
         c = result.payload['com']
-        print(f'known mass {result.payload["mass"]:g} kg: centre of mass '
-              f'found at ({1000 * c[0]:.0f}, {1000 * c[1]:.0f}, '
-              f'{1000 * c[2]:.0f}) mm in the tip frame; 15 % larger '
-              f'constants fit {100 * result.scale_rise:.2g} % worse')
+        print(f'known mass {result.payload["mass"]:g} kg: its torque '
+              f'changes by up to {result.mass_excitation.max():.2g} '
+              f'residual RMS; centre of mass found at ({1000 * c[0]:.0f}, '
+              f'{1000 * c[1]:.0f}, {1000 * c[2]:.0f}) mm in the tip frame')
 
 
 def cmd_identify(args):

@@ -59,7 +59,6 @@ import math
 import numpy as np
 
 from .errors import RobotFileError
-from .inertia import Note
 
 DRIVES_NS = 'https://newton-euler-ros.github.io/ns/drives/1'
 DRIVES_PREFIX = 'ne'
@@ -185,8 +184,7 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
     Returns None when no joint of the chain has ``<dynamics>`` or
     ``<ne:drive>``; raises RobotFileError on a bad value (one line naming
     the joint and the attribute).  ``prior=True`` (the prior of an
-    identification): negative friction is kept, with a Note appended to
-    ``notes``.
+    identification): negative friction is kept, listed in ``notes``.
     """
     joints = {el.get('name'): el for el in root.findall('joint')}
     n = len(joint_names)
@@ -206,7 +204,7 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
                 v = _number(dyn, attr, where, label,
                             minimum=None if prior else 0.0)
                 if v is not None and v < 0 and notes is not None:
-                    notes.append(_prior_note(label, where, attr, v))
+                    notes.append(f'{where} {attr}: {v:g} < 0')
                 if v is not None:
                     vals[key][j] = v
                     found = True
@@ -238,12 +236,6 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
     return Drives(vals['viscous'], vals['coulomb'], vals['offset'],
                   vals['armature'], width,
                   _all_or_none(constant, joint_names, label))
-
-
-def _prior_note(label, where, attr, value):
-    return Note(f'{label}: {where} {attr}: must be >= 0, got {value:g}; '
-                f'accepted as the prior of an identification (the fit keeps '
-                f'friction >= 0)')
 
 
 def _all_or_none(constant, joint_names, label):

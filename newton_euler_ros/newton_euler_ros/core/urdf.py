@@ -81,8 +81,8 @@ class _Source:
 
     ``prior``: the file is the prior of an identification, which makes
     every link physical anyway: physically impossible values (a negative
-    mass or principal moment, negative friction) are accepted, each with
-    a Note appended to ``notes``.
+    mass or principal moment, negative friction) are accepted, each
+    listed in ``notes`` ("where: what").
     """
 
     def __init__(self, label, prior=False, notes=None):
@@ -91,12 +91,10 @@ class _Source:
         self.notes = [] if notes is None else notes
 
     def accept(self, where, message):
-        """Note an impossible value of a prior; raise for anything else."""
+        """List an impossible value of a prior; raise for anything else."""
         if not self.prior:
             raise self.error(where, message)
-        self.notes.append(Note(f'{self.label}: {where}: {message}; accepted '
-                               f'as the prior of an identification (the fit '
-                               f'makes it physical)'))
+        self.notes.append(f'{where}: {message}')
 
     def error(self, where, message):
         return RobotFileError(f'{self.label}: {where}: {message}')
@@ -332,7 +330,7 @@ def parse_urdf(text, label='robot_description', prior=False, notes=None):
     Parse and check URDF text; return (name, root, links, joints).
 
     ``prior=True`` reads the prior of an identification: physically
-    impossible inertials are accepted, with a Note appended to ``notes``.
+    impossible inertials are accepted, each listed in ``notes``.
     """
     src = _Source(label, prior, notes)
     root = _parse(text, src)
@@ -497,7 +495,8 @@ def _tree_warnings(label, links, joints, bodies):
                      f'{_short(", ".join(sorted(set(bodies.massless))), 400)}')
     for parts in bodies.carried:
         for lname, _, _ in parts:
-            if links[lname].has_inertial:
+            # a negative moment is refused, or listed as a prior's
+            if links[lname].has_inertial and links[lname].eig[0] >= 0:
                 note = triangle_note(f'{label}: link {lname!r} <inertia>',
                                      links[lname].eig)
                 if note:
@@ -521,8 +520,8 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     joints, the merged fixed joints, the lumped subtrees and the frames
     rigidly attached to the base and to the tip (for wrenches).
     ``prior=True``: the file is the prior of an identification, read
-    leniently (:func:`parse_urdf`; negative friction too), each impossible
-    value a Note among the warnings.  Nothing else reads that way.
+    leniently (:func:`parse_urdf`; negative friction too): one Note among
+    the warnings lists the impossible values.  Nothing else reads that way.
     """
     notes = []
     name, root, links, joints = parse_urdf(text, label, prior, notes)
@@ -550,8 +549,14 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
               # friction, offset, rotor inertia (or None)
               'drives': read_drives(_parse(text, _Source(label)), moving,
                                     label, prior, notes)})
-    return (model, notes + _tree_warnings(label, links, joints, bodies),
-            report)
+    found = _tree_warnings(label, links, joints, bodies)
+    if notes:
+        found.insert(0, Note(
+            f'{label}: physically impossible values accepted as the prior of '
+            f'an identification (the fit makes every link physical and its '
+            f'friction >= 0; nothing else reads such a file): '
+            + _short('; '.join(notes), 600)))
+    return model, found, report
 
 
 def inspect_urdf(text_or_path, base=None, tip=None, label=None,

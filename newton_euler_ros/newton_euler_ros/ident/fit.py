@@ -74,7 +74,7 @@ import numpy as np
 from . import effort as effort_units
 from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
-from .constants import fit_constants
+from .constants import fit_constants, mass_excitation
 from .problem import (joint_stats, Layout, N_PAYLOAD, Recording,
                       recording_rows, stacked)
 from .reduce import IdentificationError, reduce_recording
@@ -90,11 +90,9 @@ WIDTH_SLACK = 0.01
 # a recording whose rank is below this fraction of the structural count
 # does not excite the arm
 MIN_RANK_FRACTION = 0.5
-# torque constants 15 % off must fit at least this much worse (relative
-# squared residual) with the known mass, or the mass does not fix them:
-# on UR-like recordings, constants within 6 % came with rises of 2.8 and
-# 3.4 %, constants 16 and 25 % off with 1.7 and 0.5 %
-KNOWN_MASS_RISE = 0.02
+# a known mass whose torque changes by less than this many residual RMS on
+# every joint does not fix the torque constants (constants.mass_excitation)
+KNOWN_MASS_EXCITATION = 0.5
 PAYLOAD_PRIOR = 1e-6
 
 
@@ -172,7 +170,7 @@ class Result:
     constants: str = 'none'     # 'none', 'given', 'identified'
     ratios: dict = field(default_factory=dict)   # bag: (K, explained)
     payload: dict = None        # the known mass's identified body
-    scale_rise: float = None    # known mass: worse fit of K x 1.15
+    mass_excitation: np.ndarray = None   # constants.mass_excitation
     notes: list = field(default_factory=list)
     undetermined_k: list = field(default_factory=list)  # joint indices
 
@@ -261,25 +259,32 @@ def _reduce_all(model, layout, bags, known, topic, cutoff):
         train, held, info = reduce_recording(
             path, model.joint_names, recording_rows(model, layout, loaded),
             layout.bag_columns(loaded), topic, cutoff)
+        info['held_samples'] = 0 if held is None else int(held.rows.max())
         recordings.append(Recording(str(path), train, held, info, mass))
     return recordings
 
 
-def _check_units(recordings, layout, theta0, model, mode, k_given, urdf):
-    """Per bag (K, explained); IdentificationError when impossible."""
+def _ratios(recordings, layout, theta):
+    """Per bag (K, explained) of ``effort.ratios`` for the model theta."""
     out = {}
     for rec in recordings:
         red = rec.part('all')
         u = np.zeros(red.p)
-        u[:layout.p_theta] = theta0
+        u[:layout.p_theta] = theta
         if rec.loaded:      # the known mass as a point at the tip
             u[layout.bag_columns(False)] = rec.mass
-        K, explained = effort_units.ratios(red, u, layout.drive_columns)
+        out[rec.path] = effort_units.ratios(red, u, layout.drive_columns)
+    return out
+
+
+def _check_units(recordings, layout, theta0, model, mode, k_given, urdf):
+    """Per bag (K, explained); IdentificationError when impossible."""
+    out = _ratios(recordings, layout, theta0)
+    for path, (K, explained) in out.items():
         if k_given is not None:
             K = K / k_given
-        effort_units.check(rec.path, model.joint_names, K, explained, mode,
+        effort_units.check(path, model.joint_names, K, explained, mode,
                            urdf)
-        out[rec.path] = (K, explained)
     return out
 
 
@@ -296,6 +301,20 @@ def _scale_pin(ratios, k0):
     for k, e in ratios.values():
         c += np.where((e >= effort_units.MIN_EXPLAINED) & (k > 0), e, 0.0)
     return c / c.sum()
+
+
+def _check_mass(recording, layout, sigma):
+    """Raise IdentificationError when the known mass's torque never changes."""
+    excited = mass_excitation(recording, layout, sigma)
+    if excited.max() < KNOWN_MASS_EXCITATION:
+        raise IdentificationError(
+            f'{recording.path}: the recording does not excite the known '
+            f'{recording.mass:g} kg mass: its torque changes by at most '
+            f'{excited.max():.2g} residual RMS on any joint beyond what the '
+            f'drive terms explain (move the loaded arm through poses where '
+            f'gravity acts on it differently: the shoulder and elbow '
+            f'moving)')
+    return excited
 
 
 def _determined(ratios, n):
@@ -368,6 +387,8 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
           k_given if k_given is not None else np.ones(n))
     sigma_e = _weights(recordings, layout, k0) / k0
     w = 1.0 / (sigma_e * k0)
+    excited = (_check_mass(recordings[-1], layout, sigma_e * k0)
+               if estimate_k and known else None)
     Aall, _ = stacked(recordings, 'all', layout, 0, w, k0)
     base = base_parameters(Aall[:layout.p_theta, :layout.p_theta])
     struct = structural_base(model, drives=True)
@@ -384,10 +405,16 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
                        _scales(model, theta0, D, layout, mass), mass)
     lam, width, lam_errors, width_errors = _choose(
         program, recordings, layout, w, k0)
-    K, rise, free = k0, None, None
+    K, free = k0, None
     if estimate_k:
+        # the joints whose effort the first fit's rigid-body torque explains
+        Aall, _ = stacked(recordings, 'all', layout, width, w, k0)
+        x = program.solve(Aall, lam, 'first fit')
         free = _determined(ratios, n)
-        K, rise = fit_constants(
+        if x is not None:
+            free |= _determined(_ratios(recordings, layout,
+                                        x[:layout.p_theta]), n)
+        K = fit_constants(
             recordings, layout, width, sigma_e, k0, lam, D, theta0, free,
             None if known else _scale_pin(ratios, k0), mass)
         w = 1.0 / (sigma_e * K)
@@ -416,7 +443,7 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
         recordings=[(r.path, r.info) for r in recordings],
         undetermined_k=([] if free is None
                         else [int(j) for j in np.flatnonzero(~free)]),
-        scale_rise=rise)
+        mass_excitation=excited)
     _report(result, recordings, layout, width, x, K, known, program)
     result.seconds = time.perf_counter() - start
     if validate is not None:
@@ -498,15 +525,6 @@ def _report(result, recordings, layout, width, x, K, known, program):
         from ..core.regressor import link_inertials
         m, c, Ic = link_inertials(x[layout.pay])
         result.payload = {'mass': float(m), 'com': c, 'inertia': Ic}
-        path, kg = known[0]
-        if (result.constants == 'identified'
-                and result.scale_rise < KNOWN_MASS_RISE):
-            raise IdentificationError(
-                f'{path}: the recording does not excite the known '
-                f'{kg:g} kg mass: torque constants 15 % larger fit only '
-                f'{100 * result.scale_rise:.2g} % worse (move the loaded '
-                f'arm through poses where gravity acts on the mass, with '
-                f'the shoulder and elbow moving)')
     if program.trouble:
         result.notes.append(
             f'{INACCURATE} for {", ".join(program.trouble[:3])}'

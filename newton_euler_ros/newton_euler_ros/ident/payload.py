@@ -106,12 +106,46 @@ class PayloadEstimate:
     joint_names: list = field(default_factory=list)
 
     def parameters(self):
-        """Return the node's payload.* parameters as a JSON-ready dict."""
+        """
+        Return the node's payload.* parameters as a JSON-ready dict.
+
+        What the motion does not determine is ``None`` (JSON ``null``):
+        the mass, a centre-of-mass coordinate or an inertia term, and
+        ``'undetermined'`` maps each parameter holding one to the reason.
+        A parameter without ``None`` can be set on the node as it is.
+        """
+        d = self.determined
         I = self.inertia  # noqa: E741
-        return {'payload.mass': float(self.mass),
-                'payload.com': [float(x) for x in self.com],
-                'payload.inertia': [float(I[a, b]) for a, b in
-                                    INERTIA_KEYS]}
+        com = [float(x) if ok else None for x, ok in zip(self.com, d['com'])]
+        inertia = [float(I[a, b]) if ok else None
+                   for (a, b), ok in zip(INERTIA_KEYS, d['inertia'])]
+        out = {'payload.mass': float(self.mass) if d['mass'] else None,
+               'payload.com': com, 'payload.inertia': inertia}
+        why = {}
+        if not d['mass']:
+            why['payload.mass'] = (f'standard error {self.mass_std:.3g} kg')
+        if not d['present']:
+            reason = (f'no payload: the mass is below {MASS_ABS:g} kg or '
+                      f'twice its uncertainty')
+            why['payload.com'] = why['payload.inertia'] = reason
+        else:
+            bad = [a for a, ok in zip('xyz', d['com']) if not ok]
+            if bad:
+                why['payload.com'] = (f'{", ".join(bad)} not determined by '
+                                      f'this motion')
+            bad = [k for k, ok in zip(INERTIA_NAMES, d['inertia']) if not ok]
+            if bad:
+                why['payload.inertia'] = (
+                    f'{", ".join(bad)} not determined by this motion (rotate '
+                    f'the wrist about more axes)')
+        out['undetermined'] = why
+        return out
+
+    def settable(self):
+        """Return the parameters the node can take as they are (no None)."""
+        return {k: v for k, v in self.parameters().items()
+                if k.startswith('payload.') and v is not None
+                and not (isinstance(v, list) and None in v)}
 
     def undetermined_lines(self):
         """One line per quantity the recording does not determine."""
@@ -127,12 +161,13 @@ class PayloadEstimate:
         bad = [a for a, ok in zip('xyz', self.determined['com']) if not ok]
         if bad:
             out.append(f'centre of mass {", ".join(bad)} undetermined by '
-                       f'this motion (the JSON value is only a guess)')
+                       f'this motion (null in the JSON)')
         bad = [n for n, ok in zip(INERTIA_NAMES, self.determined['inertia'])
                if not ok]
         if bad:
             out.append(f'inertia {", ".join(bad)} undetermined by this '
-                       f'motion (rotate the wrist about more axes)')
+                       f'motion (rotate the wrist about more axes; null in '
+                       f'the JSON)')
         return out
 
     def summary_lines(self, tip):
