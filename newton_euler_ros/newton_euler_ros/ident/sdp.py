@@ -51,9 +51,9 @@ def objective_scale(Aug, homogeneous=False):
     least residual (about 1: the rows are weighted by the residual of
     such a fit).  The program minimises the excess ||R x - z||^2, which
     the constraints and the prior make a few percent of rho^2 at most.
-    Clarabel's tolerances are absolute: on an arm's recording, 14 of 24
-    solves stopped at reduced accuracy unscaled (an objective of 0.04),
-    4 with f^2 = d / rho^2 and none with f^2 = 100 d / rho^2.  A
+    Clarabel's tolerances are absolute: on a UR-like arm's recording, 14
+    of 24 solves stopped at reduced accuracy unscaled (an objective of
+    0.04), 4 with f^2 = d / rho^2 and none with f^2 = 100 d / rho^2.  A
     ``homogeneous`` problem (torque constants among the unknowns: z = 0,
     rho = 0) minimises the whole weighted residual, about 1: f^2 = d.
     """
