@@ -240,6 +240,7 @@ def cmd_identify(args):
     for line in notes:
         print(line, file=sys.stderr)
     from .ident.fit import fixed_parts
+    from .ident.problem import REST_SPEED
     from .ident.urdf_out import atomic_write, identified_urdf
     result = _identify_or_fail(model, text, args)
     names = model.joint_names
@@ -254,6 +255,9 @@ def cmd_identify(args):
     print(f'prior weight {result.lam:g}, Coulomb width '
           f'{result.coulomb_width:g} rad/s (both chosen on held-out blocks'
           + (')' if args.coulomb_width is None else '; the width given)'))
+    print(f'fitted where each joint moves (|qd| >= {REST_SPEED:g} rad/s: at '
+          f'rest static friction holds any torque in its band); the tables '
+          f'cover every sample')
     _print_constants(result, names)
     unit = ('N m' if result.torque_constant is None else
             'N m: the effort times the torque constants')

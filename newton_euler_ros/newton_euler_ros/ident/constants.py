@@ -99,8 +99,8 @@ def mass_excitation(recording, layout, sigma):
     the loaded recording), less what the joint's own drive terms could
     explain (a constant is an offset), RMS over the recording, divided by
     the joint's residual RMS ``sigma`` (N m).  Only a mass whose torque
-    changes fixes the scale: measured on UR-like recordings, 1.1 to 1.6
-    on the shoulder for excitations of the loaded arm, below 0.1 on every
+    changes fixes the scale: measured on UR-like recordings, about 5 on
+    the shoulder for excitations of the loaded arm, 0.01 or less on every
     joint when only the base and the last wrist joint move.
     """
     red = recording.part('all')

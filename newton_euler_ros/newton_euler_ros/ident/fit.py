@@ -75,8 +75,8 @@ from . import effort as effort_units
 from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
 from .constants import fit_constants, mass_excitation
-from .problem import (joint_stats, Layout, N_PAYLOAD, Recording,
-                      recording_rows, stacked)
+from .problem import (joint_stats, Layout, Recording, recording_rows,
+                      stacked)
 from .reduce import IdentificationError, reduce_recording
 from .sdp import body_scale, INACCURATE, objective_scale, ScaledBody, solve
 from ..core.drives import DEFAULT_COULOMB_WIDTH, Drives, model_drives
@@ -186,6 +186,7 @@ class _Program:
         self.R = cp.Parameter((d, d))
         self.z = cp.Parameter(d)
         self.sl = cp.Parameter(nonneg=True)
+        self.sl_pay = cp.Parameter(nonneg=True)
         self.bodies = [ScaledBody(cp, *scales['bodies'][k])
                        for k in range(n)]
         self.dt = cp.Variable(N_DRIVE * n)
@@ -201,7 +202,9 @@ class _Program:
             pay = ScaledBody(cp, mass, 0.1)
             x.append(cp.hstack(pay.params))
             cons.append(pay.params[0] == mass)
-            obj += cp.sum_squares(cp.multiply(
+            # a faint pull of what the motion does not excite to zero,
+            # scaled with the data like the prior
+            obj += cp.sum_squares(self.sl_pay * cp.multiply(
                 scales['payload'], cp.hstack(pay.params[1:])))
         self.x = cp.hstack(x) if len(x) > 1 else theta
         obj += cp.sum_squares(self.R @ self.x - self.z)
@@ -211,11 +214,15 @@ class _Program:
     def solve(self, Aug, lam, label=''):
         """Return x (or None) for the square problem Aug and lambda."""
         d = self.layout.size
-        f = objective_scale(Aug)
-        self.R.value = f * Aug[:d, :d]
-        self.z.value = f * Aug[:d, d]
-        self.sl.value = f * float(np.sqrt(lam))
-        result = solve(self.problem, label)
+        for more in (1.0, 30.0):    # once more, larger, if it stops early
+            f = more * objective_scale(Aug)
+            self.R.value = f * Aug[:d, :d]
+            self.z.value = f * Aug[:d, d]
+            self.sl.value = f * float(np.sqrt(lam))
+            self.sl_pay.value = f * float(np.sqrt(PAYLOAD_PRIOR))
+            result = solve(self.problem, label)
+            if result.status != 'inaccurate':
+                break
         if result.status == 'inaccurate':
             self.trouble.append(label)
         if not result.ok:
@@ -239,7 +246,7 @@ def _weights(recordings, layout, k0):
     return np.maximum(rms, np.maximum(1e-3 * ref, 1e-6))
 
 
-def _scales(model, theta0, D, layout, mass):
+def _scales(model, theta0, D, layout, mass, Aall):
     """Typical sizes of the unknowns (``sdp``: solve in units of them)."""
     n = model.n
     pi0 = theta0[:N_INERTIAL * n].reshape(n, N_INERTIAL)
@@ -247,8 +254,10 @@ def _scales(model, theta0, D, layout, mass):
     Dd = D[N_INERTIAL * n:layout.p_theta]
     drives = 1.0 / np.maximum(Dd, 1e-12 * max(float(Dd.max()), 1e-300))
     payload = None
-    if mass is not None:
-        payload = np.sqrt(PAYLOAD_PRIOR) * np.full(N_PAYLOAD - 1, 1.0)
+    if mass is not None:    # the payload's columns' norms (its prior)
+        Dp = np.linalg.norm(Aall[:, layout.pay.start + 1:layout.pay.stop],
+                            axis=0)
+        payload = np.maximum(Dp, 1e-3 * max(float(np.median(Dp)), 1e-12))
     return {'bodies': bodies, 'drives': drives, 'payload': payload}
 
 
@@ -402,7 +411,7 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
     D = np.maximum(D, 1e-3 * max(float(np.median(D)), 1e-12))
     mass = known[0][1] if known else None
     program = _Program(layout, fixed, theta0, D,
-                       _scales(model, theta0, D, layout, mass), mass)
+                       _scales(model, theta0, D, layout, mass, Aall), mass)
     lam, width, lam_errors, width_errors = _choose(
         program, recordings, layout, w, k0)
     K, free = k0, None
@@ -452,8 +461,8 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
                                layout.bag_columns(False), topic, cutoff,
                                split=False)
         rec = Recording(str(validate), val[0], None, val[2])
-        result.validate_stats = _both(result, [rec], 'all', layout, width,
-                                      x, K)
+        result.validate_stats = _both(result, [rec], 'samples', layout,
+                                      width, x, K)
         result.validate_seconds = (time.perf_counter() - start
                                    - result.seconds)
     return result
@@ -516,9 +525,9 @@ def _both(result, recordings, part, layout, width, x, k_eff):
 def _report(result, recordings, layout, width, x, K, known, program):
     """Fill the result's statistics, payload and notes."""
     plain = [r for r in recordings if not r.loaded]
-    result.fit_stats = _both(result, plain, 'all', layout, width, x, K)
+    result.fit_stats = _both(result, plain, 'samples', layout, width, x, K)
     if any(r.held is not None and r.held.rows.min() > 0 for r in plain):
-        held = _both(result, plain, 'held', layout, width, x, K)
+        held = _both(result, plain, 'held_samples', layout, width, x, K)
         result.fit_stats['held_out_nominal'] = held['nominal']
         result.fit_stats['held_out_identified'] = held['identified']
     if known:

@@ -72,18 +72,26 @@ class Reduced:
         self.R = [np.zeros((0, p + 1)) for _ in range(n)]
         self.rows = np.zeros(n, dtype=np.int64)
 
-    def add(self, Y, tau):
-        """Add (m, n, p) regressor rows and (m, n) right-hand sides."""
-        m = Y.shape[0]
-        if m == 0:
+    def add(self, Y, tau, keep=None):
+        """
+        Add (m, n, p) regressor rows and (m, n) right-hand sides.
+
+        ``keep`` (m, n) bool: joint j takes only the rows keep[:, j].
+        """
+        if Y.shape[0] == 0:
             return
         for j in range(self.n):
+            sel = slice(None) if keep is None else keep[:, j]
+            Yj, tj = Y[sel, j, :], tau[sel, j]
+            m = Yj.shape[0]
+            if m == 0:
+                continue
             A = np.empty((m + self.R[j].shape[0], self.p + 1))
-            A[:m, :self.p] = Y[:, j, :]
-            A[:m, self.p] = tau[:, j]
+            A[:m, :self.p] = Yj
+            A[:m, self.p] = tj
             A[m:] = self.R[j]
             self.R[j] = np.linalg.qr(A, mode='r')
-        self.rows += m
+            self.rows[j] += m
 
     def merged(self, other):
         """Return the reduction of both sets of rows."""
@@ -174,11 +182,15 @@ def reduce_recording(path, joint_names, rows, columns, topic=DEFAULT_TOPIC,
     Reduce a recording: return (train, held_out or None, info dict).
 
     ``rows(q, qd, qdd, effort)`` returns the rows of (m,) filtered
-    samples: A (m, n, ``columns``) and y (m, n).  With ``split=False``
-    every block goes to ``train``.  Blocks are ``BLOCK_S`` long, shorter
-    for a recording under ten blocks (down to half a second), so that
-    even a short one has a held-out part.  ``info``: 'rate', 'cutoff',
-    'step' (the decimation), 'duration' (s) and 'samples' (filtered).
+    samples: A (m, n, ``columns``) and y (m, n), and optionally a third
+    (m, n) bool array: the rows each joint's fit keeps.  The rows left
+    out are reduced apart, into ``info['rest']`` = (train, held): a
+    caller can report on every sample and fit on the kept ones.  With
+    ``split=False`` every block goes to ``train``.  Blocks are
+    ``BLOCK_S`` long, shorter for a recording under ten blocks (down to
+    half a second), so that even a short one has a held-out part.
+    ``info``: 'rate', 'cutoff', 'step' (the decimation), 'duration' (s)
+    and 'samples' (filtered).
     """
     n = len(joint_names)
     block_s = BLOCK_S
@@ -186,6 +198,7 @@ def reduce_recording(path, joint_names, rows, columns, topic=DEFAULT_TOPIC,
         block_s = min(BLOCK_S, max(0.5, recording_seconds(path) / 10.0))
     train = Reduced(n, columns)
     held = Reduced(n, columns) if split else None
+    rest = None
     samples = 0
     info = {'rate': None, 'cutoff': None, 'duration': 0.0}
     t_first = None
@@ -201,16 +214,25 @@ def reduce_recording(path, joint_names, rows, columns, topic=DEFAULT_TOPIC,
         samples += len(piece)
         for a in range(0, len(idx), STATE_CHUNK):
             sel = idx[a:a + STATE_CHUNK]
-            Y, tau = rows(piece.q[sel], piece.qd[sel], piece.qdd[sel],
-                          piece.effort[sel])
-            if held is None:
-                train.add(Y, tau)
-                continue
-            block = np.floor((piece.t[sel] - t_first) / block_s)
-            out = (block % HOLDOUT_EVERY) == HOLDOUT_EVERY - 1
-            train.add(Y[~out], tau[~out])
-            held.add(Y[out], tau[out])
+            Y, tau, *keep = rows(piece.q[sel], piece.qd[sel],
+                                 piece.qdd[sel], piece.effort[sel])
+            keep = keep[0] if keep else None
+            if keep is not None and rest is None:
+                rest = (Reduced(n, columns),
+                        Reduced(n, columns) if split else None)
+            out = np.zeros(len(sel), dtype=bool)
+            if held is not None:
+                block = np.floor((piece.t[sel] - t_first) / block_s)
+                out = (block % HOLDOUT_EVERY) == HOLDOUT_EVERY - 1
+            for part, rows_in, spare in ((train, ~out, 0), (held, out, 1)):
+                if part is None:
+                    continue
+                k = None if keep is None else keep[rows_in]
+                part.add(Y[rows_in], tau[rows_in], k)
+                if keep is not None:
+                    rest[spare].add(Y[rows_in], tau[rows_in], ~k)
     info['samples'] = samples
+    info['rest'] = rest
     if samples == 0:
         raise IdentificationError(
             f'{path}: too short: nothing is left after filtering (needs '

@@ -29,8 +29,9 @@ fails.  So every variable is solved for in units where it is of order
 one: a link's pseudo-inertia as J = S Jt S with S = sqrt(mu) diag(l, l,
 l, 1) (mu its nominal mass, l its nominal radius of gyration about the
 link origin; a congruence, so Jt is PSD iff J is), every other
-parameter divided by its typical size, and the objective scaled to about
-the number of unknowns (:func:`objective_scale`).  :class:`Solve` records what the solver
+parameter divided by its typical size, and the objective scaled up
+(:func:`objective_scale`; a solve that still stops early is repeated
+once with it 30 times larger).  :class:`Solve` records what the solver
 reported; an answer at reduced accuracy is kept (it is a feasible,
 nearly optimal point) and said in one line by the command.
 """
@@ -42,27 +43,27 @@ MIN_LENGTH = 0.02      # m, least length scale of a link
 MIN_MASS = 0.05        # kg, least mass scale of a link
 
 
-def objective_scale(Aug, homogeneous=False):
+def objective_scale(Aug):
     """
-    Return f: the objective times f^2 is about the number of unknowns.
+    Return f: the objective times f^2 is about 1e4 times the unknowns.
 
     ``Aug`` is the augmented square problem [R z; 0 rho] of a weighted
     least-squares fit ||R x - z||^2 + rho^2, rho^2 the unconstrained
     least residual (about 1: the rows are weighted by the residual of
     such a fit).  The program minimises the excess ||R x - z||^2, which
     the constraints and the prior make a few percent of rho^2 at most.
-    Clarabel's tolerances are absolute: on a UR-like arm's recording, 14
-    of 24 solves stopped at reduced accuracy unscaled (an objective of
-    0.04), 4 with f^2 = d / rho^2 and none with f^2 = 100 d / rho^2.  A
-    ``homogeneous`` problem (torque constants among the unknowns: z = 0,
-    rho = 0) minimises the whole weighted residual, about 1: f^2 = d.
+    Clarabel's tolerances are absolute, and measured on UR-like
+    recordings the larger objective is the safer: unscaled, 14 of 24
+    solves stopped at reduced accuracy (an objective of 0.04); with
+    f^2 = 100 d / rho^2, 3 of 63 over five recordings; with
+    f^2 = 1e4 d / rho^2, 2 solves at prior weights of 1e-7 and 1e-6 with
+    a known mass, which the repeat with 30 times that brought to full
+    accuracy.
     """
     d = Aug.shape[0] - 1
-    if homogeneous:
-        return float(np.sqrt(d))
     floor = float(Aug[d, d]) ** 2
     total = floor + float(Aug[:d, d] @ Aug[:d, d])
-    return float(np.sqrt(100.0 * d / max(floor, 1e-6 * total, 1e-300)))
+    return float(np.sqrt(1e4 * d / max(floor, 1e-6 * total, 1e-300)))
 
 
 def pi_of_pseudo(J):
