@@ -15,16 +15,19 @@
 """
 ``newton-euler identify`` and ``newton-euler replay``.
 
-    newton-euler identify NOMINAL.urdf BAG --base LINK --tip LINK
+    newton-euler identify NOMINAL.urdf BAG [BAG ...] --base LINK --tip LINK
                           -o IDENTIFIED.urdf [--topic T] [--validate BAG2]
+                          [--effort torque|current] [--known-mass BAG KG]
                           [--coulomb-width EPS] [--cutoff HZ] [--overwrite]
     newton-euler replay MODEL.urdf BAG --base LINK --tip LINK --csv OUT.csv
                         [--plot OUT.png] [--topic T] [--cutoff HZ]
 
 Every problem with an input (a bag that is missing, corrupt or truncated,
 lacks the topic, the effort or a chain joint, is too short or does not
-excite the arm; an unusable URDF; an output that would overwrite the
-input) is one line on stderr naming the file, exit status 2.  Every file
+excite the arm, has efforts that cannot be in the unit ``--effort`` says;
+a known-mass recording that does not excite the mass; an unusable URDF;
+an output that would overwrite the input) is one line on stderr naming
+the file, exit status 2, and nothing is written.  Every file
 written (URDF, CSV, plot) is written atomically.  The identification
 pipeline (``newton_euler_ros.ident``) is imported only by these
 commands, never by the nodes.
@@ -46,16 +49,28 @@ def register(subparsers):
                          'recording of /joint_states; write a URDF')
     ide.add_argument('nominal', metavar='NOMINAL.urdf',
                      help='the URDF to start from (the prior)')
-    ide.add_argument('bag', metavar='BAG', help='rosbag2 directory (MCAP or '
-                                                'sqlite3)')
+    ide.add_argument('bag', metavar='BAG', nargs='+',
+                     help='rosbag2 directory (MCAP or sqlite3); several are '
+                          'fitted together')
     _common(ide)
     ide.add_argument('-o', '--output', metavar='IDENTIFIED.urdf',
                      required=True, help='URDF to write')
     ide.add_argument('--validate', metavar='BAG2',
                      help='a second recording to report the models on')
+    ide.add_argument('--effort', choices=('torque', 'current'),
+                     default='torque',
+                     help='what JointState.effort is: joint torque in N m '
+                          '(default; Franka, KUKA) or proportional to it, '
+                          "a motor current (UR's default): the torque "
+                          'constants are identified and written')
+    ide.add_argument('--known-mass', nargs=2, metavar=('BAG', 'KG'),
+                     help='a recording with a known mass added at the tip '
+                          'link (its centre of mass and inertia need not be '
+                          "known): fixes the torque constants' scale")
     ide.add_argument('--coulomb-width', type=float, metavar='EPS',
                      help='Coulomb smoothing width of tanh(qd / EPS), rad/s '
-                          "(default 0.02, or the nominal URDF's)")
+                          '(default: chosen on held-out blocks among 0.005 '
+                          "... 0.1 and the nominal URDF's)")
     ide.add_argument('--overwrite', action='store_true',
                      help='allow -o to be the input URDF')
     ide.set_defaults(func=_one_line_exit_2(cmd_identify))
@@ -107,8 +122,14 @@ def _one_line_exit_2(command):
     return run
 
 
-def _load_urdf(path, base, tip):
-    """Return (model, text, notes) or fail with one line."""
+def _load_urdf(path, base, tip, prior=False):
+    """
+    Return (model, text, notes) or fail with one line.
+
+    ``prior=True``: the URDF is identify's prior, read leniently
+    (``core.urdf``: impossible inertials and negative friction accepted,
+    each with a note).
+    """
     from .core import NewtonEulerError
     from .core.robot_file import Note
     from .core.urdf import inspect_urdf, read_urdf_text
@@ -117,7 +138,7 @@ def _load_urdf(path, base, tip):
     try:
         text, label = read_urdf_text(path)
         model, found, _ = inspect_urdf(text, base=base, tip=tip,
-                                       label=path)
+                                       label=path, prior=prior)
     except NewtonEulerError as exc:
         _fail(str(exc))
     notes = []
@@ -151,9 +172,60 @@ def _stats_table(title, names, stats):
     return float(np.mean(rel0)), float(np.mean(rel1))
 
 
+def _known_mass(args):
+    """Return (bag, kg) of --known-mass, or None; one line if bad."""
+    if args.known_mass is None:
+        return None
+    bag, kg = args.known_mass
+    try:
+        mass = float(kg)
+    except ValueError:
+        mass = float('nan')
+    if not (mass > 0 and np.isfinite(mass)):
+        _fail(f'--known-mass {bag} {kg}: the mass must be a positive number '
+              f'of kg')
+    return bag, mass
+
+
+def _identify_or_fail(model, text, args):
+    from .core import NewtonEulerError
+    from .ident.fit import identify
+    known = _known_mass(args)
+    try:
+        return identify(model, args.bag, topic=args.topic,
+                        validate=args.validate,
+                        coulomb_width=args.coulomb_width,
+                        cutoff=args.cutoff, urdf_text=text,
+                        effort=args.effort, known_mass=known,
+                        urdf_label=args.nominal)
+    except (NewtonEulerError, ValueError) as exc:
+        line = str(exc)
+        files = list(args.bag) + [args.validate, known and known[0]]
+        named = any(line.startswith(str(p)) for p in files if p)
+        _fail(line if named else f'{args.bag[0]}: {line}')
+
+
+def _print_constants(result, names):
+    K = result.torque_constant
+    if K is None:
+        return
+    how = {'given': 'as given in the nominal URDF',
+           'identified': 'identified'}[result.constants]
+    print(f'torque constants (N m per effort unit), {how}:')
+    for j, name in enumerate(names):
+        tag = ('  (not determined by the recordings: the mean of the '
+               'others)' if j in result.undetermined_k else '')
+        print(f'  {name:<24}{K[j]:>10.4g}{tag}')
+    if result.payload is not None:
+        c = result.payload['com']
+        print(f'known mass {result.payload["mass"]:g} kg: its torque '
+              f'changes by up to {result.mass_excitation.max():.2g} '
+              f'residual RMS; centre of mass found at ({1000 * c[0]:.0f}, '
+              f'{1000 * c[1]:.0f}, {1000 * c[2]:.0f}) mm in the tip frame')
+
+
 def cmd_identify(args):
     """Run ``newton-euler identify``."""
-    from .core import NewtonEulerError
     start = time.perf_counter()
     src = os.path.abspath(args.nominal)
     out = os.path.abspath(args.output)
@@ -165,33 +237,35 @@ def cmd_identify(args):
         _fail(f'{args.output}: the directory does not exist')
     if args.coulomb_width is not None and not args.coulomb_width > 0:
         _fail(f'--coulomb-width must be > 0, got {args.coulomb_width:g}')
-    model, text, notes = _load_urdf(args.nominal, args.base, args.tip)
+    _known_mass(args)
+    model, text, notes = _load_urdf(args.nominal, args.base, args.tip,
+                                    prior=True)
     for line in notes:
         print(line, file=sys.stderr)
-    from .ident.fit import fixed_parts, identify
+    from .ident.fit import fixed_parts
+    from .ident.problem import REST_SPEED
     from .ident.urdf_out import atomic_write, identified_urdf
-    try:
-        result = identify(model, args.bag, topic=args.topic,
-                          validate=args.validate,
-                          coulomb_width=args.coulomb_width,
-                          cutoff=args.cutoff, urdf_text=text)
-    except (NewtonEulerError, ValueError) as exc:
-        text = str(exc)
-        named = any(text.startswith(str(p)) for p in (args.bag,
-                                                      args.validate) if p)
-        _fail(text if named else f'{args.bag}: {text}')
-    info = result.info
+    result = _identify_or_fail(model, text, args)
     names = model.joint_names
-    print(f'recording {args.bag}: {info["samples"]} samples over '
-          f'{info["duration"]:.1f} s at {info["rate"]:.0f} Hz, low-pass '
-          f'{info["cutoff"]:g} Hz, fit on every {info["step"]} sample(s)')
+    for path, info in result.recordings:
+        print(f'recording {path}: {info["samples"]} samples over '
+              f'{info["duration"]:.1f} s at {info["rate"]:.0f} Hz, low-pass '
+              f'{info["cutoff"]:g} Hz, fit on every {info["step"]} '
+              f'sample(s)')
     print(f'rank {result.rank} of {result.structural_rank} base parameters '
           f'(of {14 * model.n}: 10 inertial + 4 drive per joint); '
           f'condition number {result.condition:.3g}')
-    print(f'prior weight {result.lam:g} (chosen on held-out blocks); '
-          f'Coulomb width {result.coulomb_width:g} rad/s')
-    _stats_table('torque residual on the recording (N m; relative to the '
-                 'RMS effort):', names, {
+    print(f'prior weight {result.lam:g}, Coulomb width '
+          f'{result.coulomb_width:g} rad/s (both chosen on held-out blocks'
+          + (')' if args.coulomb_width is None else '; the width given)'))
+    print(f'fitted where each joint moves (|qd| >= {REST_SPEED:g} rad/s: at '
+          f'rest static friction holds any torque in its band); the tables '
+          f'cover every sample')
+    _print_constants(result, names)
+    unit = ('N m' if result.torque_constant is None else
+            'N m: the effort times the torque constants')
+    _stats_table(f'torque residual on the recording ({unit}; relative to '
+                 f'the RMS effort):', names, {
                      'nominal': result.fit_stats['nominal'],
                      'identified': result.fit_stats['identified']})
     worse = []
@@ -210,12 +284,14 @@ def cmd_identify(args):
     f1 = float(np.mean(result.fit_stats['identified'][1]))
     if f1 >= f0:
         worse.append('the recording')
-    fixed = fixed_parts(model, text)
+    fixed = fixed_parts(model, text, prior=True)
     body = identified_urdf(text, model, result.theta, fixed, result.drives)
     try:
         atomic_write(out, body)
     except OSError as exc:
         _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
+    for line in result.notes:
+        print(f'note: {line}', file=sys.stderr)
     for where in worse:
         print(f'warning: the identified model does WORSE than the nominal on '
               f'{where}: check the recording (excitation, effort units, '
@@ -235,7 +311,6 @@ def cmd_replay(args):
     from .ident.bag import read_joint_states
     from .ident.fit import predict
     from .ident.signals import prepare
-    from .ident.urdf_out import atomic_open
     for opt, path in (('--csv', args.csv), ('--plot', args.plot)):
         if path is not None and not os.path.isdir(
                 os.path.dirname(os.path.abspath(path))):
@@ -253,6 +328,9 @@ def cmd_replay(args):
     if prep is None:
         _fail(f'{args.bag}: too short: nothing is left after filtering')
     model_tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
+    current = drives is not None and drives.torque_constant is not None
+    if current:     # compared in the effort's own unit
+        model_tau = drives.torque_to_effort(model_tau)
     # the messages inside the filtered stretches (edges left out)
     i = np.clip(np.searchsorted(prep.t, js.stamps), 1, len(prep.t) - 1)
     near = np.minimum(np.abs(prep.t[i] - js.stamps),
@@ -260,15 +338,60 @@ def cmd_replay(args):
     keep = near <= 1.0 / prep.rate
     n = model.n
     at = js.stamps[keep]
-    mod = np.column_stack([np.interp(at, prep.t, model_tau[:, j])
-                           for j in range(n)])
-    low = np.column_stack([np.interp(at, prep.t, prep.effort[:, j])
-                           for j in range(n)])
+    mod, low, speed = (np.column_stack([np.interp(at, prep.t, X[:, j])
+                                        for j in range(n)])
+                       for X in (model_tau, prep.effort, prep.qd))
     meas = js.effort[keep]
     ns = js.stamps_ns[keep]
     names = model.joint_names
+    _write_replay_csv(args.csv, names, ns, meas, mod)
+    moving = np.abs(speed) > MOVING
+    print(f'{args.bag}: {len(ns)} of {len(js)} messages (filter edges and '
+          f'gaps left out); model {args.model}'
+          + ('' if drives is not None else ' (no drive terms)'))
+    unit = ("the effort's unit: the model torque / torque_constant"
+            if current else 'N m')
+    _table(f'model against the measured effort ({unit}; relative to the '
+           f'RMS effort; "moving": samples where the joint turns faster '
+           f'than {MOVING:g} rad/s):', names,
+           [('RMS raw', _rms(mod - meas), '{:.4g}'),
+            ('rel % raw', 100 * _rel(mod, meas), '{:.2f}'),
+            ('rel % moving', 100 * _rel(mod, meas, moving), '{:.2f}'),
+            (f'rel % {prep.cutoff:g} Hz', 100 * _rel(mod, low), '{:.2f}')])
+    print(textwrap.fill(
+        f'(the {prep.cutoff:g} Hz column compares with the effort '
+        f'low-passed like the state: free of noise, but smoothed where a '
+        f"joint reverses, while the model's friction still switches "
+        f'sharply there, so on a joint with friction and little noise '
+        f'it can exceed the raw one; docs/identification.md)', 78,
+        initial_indent='  ', subsequent_indent='   '))
+    print(f'wrote {args.csv}')
+    if args.plot:
+        _plot(args.plot, (ns - ns[0]) * 1e-9, names, meas, mod, low,
+              'effort' if current else 'N m')
+        print(f'wrote {args.plot}')
+    return 0
+
+
+MOVING = 0.05       # rad/s (m/s): a joint moves faster than this
+
+
+def _rms(err, mask=None):
+    """RMS per column (over the rows where ``mask`` is true)."""
+    mask = np.ones(err.shape, dtype=bool) if mask is None else mask
+    return np.sqrt(np.sum(np.where(mask, err, 0.0) ** 2, axis=0)
+                   / np.maximum(mask.sum(axis=0), 1))
+
+
+def _rel(model, meas, mask=None):
+    """RMS error relative to the RMS measurement, per column."""
+    return _rms(model - meas, mask) / np.maximum(_rms(meas, mask), 1e-300)
+
+
+def _write_replay_csv(path, names, ns, meas, mod):
+    from .ident.urdf_out import atomic_open
     try:
-        with atomic_open(args.csv) as f:
+        with atomic_open(path) as f:
             f.write('time,' + ','.join(f'{x}.measured,{x}.model'
                                        for x in names) + '\n')
             for a in range(0, len(ns), 10000):
@@ -283,35 +406,10 @@ def cmd_replay(args):
                                 f'{t % 1_000_000_000:09d},{cells}\n')
                 f.write(''.join(rows))
     except OSError as exc:
-        _fail(f'{args.csv}: cannot write: {exc.strerror or exc}')
-    err = mod - meas
-    rms = np.sqrt(np.mean(err ** 2, axis=0))
-    rel = rms / np.maximum(np.sqrt(np.mean(meas ** 2, axis=0)), 1e-300)
-    rms_l = np.sqrt(np.mean((mod - low) ** 2, axis=0))
-    rel_l = rms_l / np.maximum(np.sqrt(np.mean(low ** 2, axis=0)), 1e-300)
-    print(f'{args.bag}: {len(ns)} of {len(js)} messages (filter edges and '
-          f'gaps left out); model {args.model}'
-          + ('' if drives is not None else ' (no drive terms)'))
-    _table('model torque against the measured effort (N m; relative to the '
-           'RMS effort):', names,
-           [('RMS raw', rms, '{:.4g}'), ('rel % raw', rel * 100, '{:.2f}'),
-            (f'RMS {prep.cutoff:g} Hz', rms_l, '{:.4g}'),
-            (f'rel % {prep.cutoff:g} Hz', rel_l * 100, '{:.2f}')])
-    print(textwrap.fill(
-        f'(the {prep.cutoff:g} Hz columns compare with the effort '
-        f'low-passed like the state: free of noise, but smoothed where a '
-        f"joint reverses, while the model's friction still switches "
-        f'sharply there, so on a joint with friction and little noise '
-        f'they can exceed the raw ones; docs/identification.md)', 78,
-        initial_indent='  ', subsequent_indent='   '))
-    print(f'wrote {args.csv}')
-    if args.plot:
-        _plot(args.plot, (ns - ns[0]) * 1e-9, names, meas, mod, low)
-        print(f'wrote {args.plot}')
-    return 0
+        _fail(f'{path}: cannot write: {exc.strerror or exc}')
 
 
-def _plot(path, t, names, meas, mod, low):
+def _plot(path, t, names, meas, mod, low, unit):
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
@@ -323,7 +421,7 @@ def _plot(path, t, names, meas, mod, low):
         ax.plot(t, meas[:, j], color='0.7', lw=0.6, label='measured')
         ax.plot(t, low[:, j], color='k', lw=0.9, label='measured, low-pass')
         ax.plot(t, mod[:, j], color='tab:red', lw=0.9, label='model')
-        ax.set_ylabel(f'{names[j]}\nN m', fontsize=8)
+        ax.set_ylabel(f'{names[j]}\n{unit}', fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0, 0].legend(loc='upper right', fontsize=7, ncol=3)
     axes[-1, 0].set_xlabel('time (s)')

@@ -112,7 +112,9 @@ def register(subparsers):
     pay.add_argument('--cutoff', type=float, metavar='HZ',
                      help='low-pass cutoff (default as identify)')
     pay.add_argument('--json', action='store_true',
-                     help="print the node's payload.* parameters as JSON")
+                     help="print the node's payload.* parameters as JSON "
+                          '(null where the motion does not determine a '
+                          'value; "undetermined" says why)')
     pay.set_defaults(func=_one_line_exit_2(cmd_payload))
 
 

@@ -108,8 +108,11 @@ def identify_once(bag):
 
 
 def _child(bag):
+    # one BLAS thread, as the newton-euler command sets it (cli.py)
+    env = dict(os.environ, OPENBLAS_NUM_THREADS='1')
     out = subprocess.run([sys.executable, '-m', MODULE, '--identify',
-                          bag], capture_output=True, text=True, check=True)
+                          bag], capture_output=True, text=True, check=True,
+                         env=env)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 

@@ -40,7 +40,7 @@ def _smoothstep(x):
     return s, ds, dds
 
 
-def excitation(seed=0, seconds=60.0, period=12.0, harmonics=5, rest=2.0,
+def excitation(seed=0, seconds=60.0, period=20.0, harmonics=6, rest=2.0,
                ramp=3.0, scale=1.0):
     """
     Return a Fourier series per joint, faded in and out, resting at the ends.

@@ -416,9 +416,14 @@ class Loop:
     def estimate_payload(self):
         """5: ``payload --json`` on the second recording."""
         self.steps.begin('payload', '[5/6] newton-euler payload --json')
-        self.estimate = json.loads(newton_euler(
+        found = json.loads(newton_euler(
             'payload', self.identified, self.bag2, '--base', BASE, '--tip',
             TIP, '--json', log=self.path('payload.json')))
+        # what the motion does not determine is null: the node keeps its
+        # value of those parameters
+        self.estimate = {k: v for k, v in found.items()
+                         if k.startswith('payload.') and v is not None
+                         and not (isinstance(v, list) and None in v)}
         self.steps.end()
 
     def apply_estimate(self):

@@ -94,7 +94,7 @@ def summary_lines(loop, payload, wall, rows):
     with open(os.path.join(out, 'identify.txt'), encoding='utf-8') as f:
         ident_lines = [x for x in f.read().splitlines()
                        if x.startswith(('rank', 'identified in'))]
-    m, c = estimate['payload.mass'], estimate['payload.com']
+    m, c = estimate.get('payload.mass'), estimate.get('payload.com')
     lines = [
         '# The identification loop, end to end',
         '',
@@ -127,8 +127,11 @@ def summary_lines(loop, payload, wall, rows):
         '',
         f'- excite: {excite_lines[0].strip() if excite_lines else ""}',
         *[f'- identify: {x}' for x in ident_lines],
-        f'- payload estimate: {m:.3f} kg (true {payload["mass"]:g}), com '
-        f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm (true '
+        '- payload estimate: '
+        + (f'{m:.3f} kg' if m is not None else 'mass undetermined')
+        + f' (true {payload["mass"]:g}), com '
+        + (f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm'
+           if c is not None else 'undetermined') + ' (true '
         f'[{", ".join(f"{1000 * v:.1f}" for v in payload["com"])}])',
         '- wall time per step (s; the nodes of a run start while an earlier '
         'step works): ' + ', '.join(f'{k} {v:.1f}'

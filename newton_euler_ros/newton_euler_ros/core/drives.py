@@ -176,13 +176,15 @@ def _number(el, attr, where, label, minimum=None):
     return value
 
 
-def read_drives(root, joint_names, label='robot_description'):
+def read_drives(root, joint_names, label='robot_description', prior=False,
+                notes=None):
     """
     Drives of ``joint_names`` from a parsed URDF (an ElementTree root).
 
     Returns None when no joint of the chain has ``<dynamics>`` or
     ``<ne:drive>``; raises RobotFileError on a bad value (one line naming
-    the joint and the attribute).
+    the joint and the attribute).  ``prior=True`` (the prior of an
+    identification): negative friction is kept, listed in ``notes``.
     """
     joints = {el.get('name'): el for el in root.findall('joint')}
     n = len(joint_names)
@@ -199,7 +201,10 @@ def read_drives(root, joint_names, label='robot_description'):
             where = f'joint {name!r} <dynamics>'
             for attr, key in (('damping', 'viscous'),
                               ('friction', 'coulomb')):
-                v = _number(dyn, attr, where, label, minimum=0.0)
+                v = _number(dyn, attr, where, label,
+                            minimum=None if prior else 0.0)
+                if v is not None and v < 0 and notes is not None:
+                    notes.append(f'{where} {attr}: {v:g} < 0')
                 if v is not None:
                     vals[key][j] = v
                     found = True

@@ -58,19 +58,17 @@ import numpy as np
 
 from .drives import read_drives
 from .errors import RobotFileError, RobotFileWarning
-from .inertia import format_moments, Note, principal_moments, triangle_note
-from .model import make_chain, pose_matrix, PRISMATIC, REVOLUTE, rpy_matrix
+from .inertia import format_moments, Note, principal_moments
+from .model import pose_matrix, rpy_matrix
 from .text import clip, read_text
-from .urdf_tree import (attached, chain_ends, check_link, combine,
-                        mimic_cycle)
+from .urdf_chain import chain_model
+from .urdf_tree import check_link, mimic_cycle
 from .urdf_whole import tree_model
 from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
 
 MAX_BYTES = 16 * 1024 * 1024
 MAX_ELEMENTS = 20000
 MAX_NAME = 200
-MOVING = {'revolute': REVOLUTE, 'continuous': REVOLUTE,
-          'prismatic': PRISMATIC}
 JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'fixed', 'floating',
                'planar')
 
@@ -80,10 +78,25 @@ def _short(text, limit=MAX_NAME):
 
 
 class _Source:
-    """The origin of a URDF (for messages) and its parse tree."""
+    """
+    The origin of a URDF (for messages) and how strictly it is read.
 
-    def __init__(self, label):
+    ``prior``: the file is the prior of an identification, which makes
+    every link physical anyway: physically impossible values (a negative
+    mass or principal moment, negative friction) are accepted, each
+    listed in ``notes`` ("where: what").
+    """
+
+    def __init__(self, label, prior=False, notes=None):
         self.label = label
+        self.prior = prior
+        self.notes = [] if notes is None else notes
+
+    def accept(self, where, message):
+        """List an impossible value of a prior; raise for anything else."""
+        if not self.prior:
+            raise self.error(where, message)
+        self.notes.append(f'{where}: {message}')
 
     def error(self, where, message):
         return RobotFileError(f'{self.label}: {where}: {message}')
@@ -193,15 +206,6 @@ def _origin(el, where, src):
     return xyz, rpy
 
 
-def _origin_ops(xyz, rpy):
-    ops = []
-    if any(xyz):
-        ops.append(('xyz',) + tuple(xyz))
-    if any(rpy):
-        ops.append(('rpy',) + tuple(rpy))
-    return ops
-
-
 class _Link:
     def __init__(self, name):
         self.name = name
@@ -229,6 +233,16 @@ class _Joint:
     def origin(self):
         return pose_matrix(self.xyz, self.rpy)
 
+    @property
+    def origin_ops(self):
+        """Return the ``<origin>`` as the model's transform operations."""
+        ops = []
+        if any(self.xyz):
+            ops.append(('xyz',) + tuple(self.xyz))
+        if any(self.rpy):
+            ops.append(('rpy',) + tuple(self.rpy))
+        return ops
+
 
 def _name(el, what, src, index):
     name = el.get('name')
@@ -253,7 +267,7 @@ def _read_inertial(link, el, src):
         raise src.error(where, 'missing <mass>')
     mass = _numbers(mass_el, 'value', 1, f'{where}<mass>', src)[0]
     if mass < 0.0:
-        raise src.error(f'{where}<mass> value', f'must be >= 0, got {mass}')
+        src.accept(f'{where}<mass> value', f'must be >= 0, got {mass}')
     in_el = inertial.find('inertia')
     if in_el is None:
         raise src.error(where, 'missing <inertia>')
@@ -265,8 +279,8 @@ def _read_inertial(link, el, src):
                         [vals['ixz'], vals['iyz'], vals['izz']]])
     eig, valid = principal_moments(inertia)
     if not valid:
-        raise src.error(f'{where}<inertia>', 'not positive semi-definite '
-                        f'(principal moments {format_moments(eig)})')
+        src.accept(f'{where}<inertia>', 'not positive semi-definite '
+                   f'(principal moments {format_moments(eig)})')
     R = rpy_matrix(*rpy)
     link.mass = mass
     link.com = np.array(xyz)
@@ -329,9 +343,14 @@ def _read_joint(el, index, src, links):
     return joint
 
 
-def parse_urdf(text, label='robot_description'):
-    """Parse and check URDF text; return (name, links, joints) dicts."""
-    src = _Source(label)
+def parse_urdf(text, label='robot_description', prior=False, notes=None):
+    """
+    Parse and check URDF text; return (name, root, links, joints).
+
+    ``prior=True`` reads the prior of an identification: physically
+    impossible inertials are accepted, each listed in ``notes``.
+    """
+    src = _Source(label, prior, notes)
     root = _parse(text, src)
     name = root.get('name') or 'robot'
     link_els = root.findall('link')
@@ -393,127 +412,6 @@ def parse_urdf(text, label='robot_description'):
     return name, roots[0], links, joints
 
 
-def _moving_joints(label, joints, chain, base, tip):
-    """Return the chain's moving joints; a floating or planar one is an error."""
-    for jname in chain:
-        kind = joints[jname].kind
-        if kind in ('floating', 'planar'):
-            raise RobotFileError(
-                f'{label}: joint {jname!r} type: a {kind} joint is on the '
-                f'chain from {base!r} to {tip!r}; only revolute, continuous,'
-                f' prismatic and fixed joints can be')
-    moving = [j for j in chain if joints[j].kind in MOVING]
-    if not moving:
-        raise RobotFileError(f'{label}: no revolute, continuous or prismatic'
-                             f' joint between {base!r} and {tip!r}')
-    return moving
-
-
-def _placements(joints, chain, moving):
-    """
-    Return (pre, merged, tool): each moving joint's placement ops.
-
-    A fixed joint's origin is merged into the next moving joint's; those
-    after the last moving joint make the tool transform.
-    """
-    pre, merged, pending = [], [], []
-    for jname in chain:
-        joint = joints[jname]
-        if joint.kind == 'fixed':
-            pending += _origin_ops(joint.xyz, joint.rpy)
-            merged.append(jname)
-            continue
-        pre.append(tuple(pending + _origin_ops(joint.xyz, joint.rpy)))
-        pending = []
-    tool = np.eye(4)
-    for jname in chain[chain.index(moving[-1]) + 1:]:
-        tool = tool @ joints[jname].origin
-    return pre, merged, tool
-
-
-class _Bodies:
-    """The rigid body each moving joint carries, and what went into it."""
-
-    def __init__(self, links, joints, base, chain, moving):
-        self.mass, self.com, self.inertia, self.carried = [], [], [], []
-        self.lumped = []        # (joint, kind) of off-chain subtrees
-        self.locked = []        # off-chain moving joints, at any depth
-        self.massless = []      # links without <inertial>
-        chain_links = {base} | {joints[j].child for j in chain}
-        for k, jname in enumerate(moving):
-            stop = {moving[k + 1]} if k + 1 < len(moving) else set()
-            parts = attached(links, joints, joints[jname].child, stop)
-            m, c, inertia_k = combine(parts, links)
-            self.mass.append(m)
-            self.com.append(c)
-            self.inertia.append(inertia_k)
-            self.carried.append(parts)
-            for lname, _, via in parts:
-                joint = joints[via] if via is not None else None
-                # a massless link on a fixed joint is a frame (tool0,
-                # ee_link, flange): nothing to warn about
-                if not links[lname].has_inertial and not (
-                        joint is not None and joint.kind == 'fixed'):
-                    self.massless.append(lname)
-                if joint is not None and via not in chain:
-                    if joint.parent in chain_links:
-                        self.lumped.append((via, joint.kind))
-                    if joint.kind != 'fixed':
-                        self.locked.append(via)
-
-
-def _attached_frames(links, joints, base, moving, tip_parts, tool):
-    """Return (tip_frames, base_frames): frames rigid with tip and base."""
-    tool_inv = np.linalg.inv(tool)
-    tip_frames = {lname: tool_inv @ T for lname, T, _ in tip_parts}
-    base_frames = {}
-    for lname, T, via in attached(links, joints, base, {moving[0]}):
-        if via is None or joints[via].kind == 'fixed':
-            base_frames[lname] = T
-    # links above the base, when they are joined to it by fixed joints
-    lname, T = base, np.eye(4)
-    while links[lname].parent_joint is not None:
-        joint = joints[links[lname].parent_joint]
-        if joint.kind != 'fixed':
-            break
-        T = T @ np.linalg.inv(joint.origin)
-        lname = joint.parent
-        base_frames[lname] = T
-    return tip_frames, base_frames
-
-
-def _locked_text(joint):
-    if joint.mimic:
-        other, mult, off = joint.mimic
-        return (f'{joint.name} ({joint.kind}, mimic of {other}, at '
-                f'{off:g})')
-    return f'{joint.name} ({joint.kind})'
-
-
-def _tree_warnings(label, links, joints, bodies):
-    """Return what the user should know of the tree: locked, massless, odd."""
-    found = []
-    # fixed joints off the chain (a hand, a camera, ee_link) are merged as
-    # those on it are: a correct model; moving ones are locked
-    if bodies.locked:
-        found.append(
-            f'{label}: moving joints off the chain locked at zero (their '
-            f'motion is not modelled; their links are lumped rigidly into '
-            f'the chain): ' + _short(', '.join(
-                _locked_text(joints[j]) for j in bodies.locked), 400))
-    if bodies.massless:
-        found.append(f'{label}: links without <inertial> are massless: '
-                     f'{_short(", ".join(sorted(set(bodies.massless))), 400)}')
-    for parts in bodies.carried:
-        for lname, _, _ in parts:
-            if links[lname].has_inertial:
-                note = triangle_note(f'{label}: link {lname!r} <inertia>',
-                                     links[lname].eig)
-                if note:
-                    found.append(note)
-    return found
-
-
 def _chain_limits(joints, moving):
     """Each moving joint's limits; a velocity or effort of 0 is not given."""
     return [{key: value for key, value in joints[j].limits.items()
@@ -522,7 +420,7 @@ def _chain_limits(joints, moving):
 
 
 def urdf_model(text, label='robot_description', base=None, tip=None,
-               gravity=(0.0, 0.0, -9.81)):
+               gravity=(0.0, 0.0, -9.81), prior=False):
     """
     Build the model of URDF text; return (model, warnings, report).
 
@@ -530,50 +428,45 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     With it, the chain; ``report`` describes what was made of the tree:
     the chain's links and joints, the merged fixed joints, the lumped
     subtrees and the frames rigidly attached to the base and to the tip
-    (for wrenches).
+    (for wrenches).  ``prior=True``: the file is the prior of an
+    identification, read leniently (:func:`parse_urdf`; negative friction
+    too): one Note among the warnings lists the impossible values.
+    Nothing else reads that way.
     """
-    name, root, links, joints = parse_urdf(text, label)
+    notes = []
+    name, root, links, joints = parse_urdf(text, label, prior, notes)
     if tip is None:
         base = root if base is None else base
         check_link(label, links, 'base', base)
-        return tree_model(
+        model, found, report = tree_model(
             name, label, links, joints, base, gravity,
             lambda names: _chain_limits(joints, names),
             lambda names: read_drives(_parse(text, _Source(label)), names,
-                                      label))
-    base, tip, chain = chain_ends(label, links, joints, root, base, tip)
-    moving = _moving_joints(label, joints, chain, base, tip)
-    pre, merged, tool = _placements(joints, chain, moving)
-    bodies = _Bodies(links, joints, base, chain, moving)
-    tip_frames, base_frames = _attached_frames(
-        links, joints, base, moving, bodies.carried[-1], tool)
-    report = {
-        'base': base, 'tip': tip, 'chain': chain, 'moving': moving,
-        'chain_links': [joints[j].child for j in chain],
-        'links': [joints[j].child for j in moving],
-        'merged_fixed': merged, 'lumped': [v for v, _ in bodies.lumped],
-        'locked': list(bodies.locked),
-        'tip_frames': tip_frames, 'base_frames': base_frames,
-        'continuous': [j for j in moving if joints[j].kind == 'continuous'],
-    }
-    model = make_chain(
-        name=name, joint_names=moving,
-        joint_types=[MOVING[joints[j].kind] for j in moving],
-        joint_pre=pre, joint_axis=[joints[j].axis for j in moving],
-        mass=bodies.mass, com=bodies.com, inertia=bodies.inertia,
-        gravity=gravity, tool=tool, limits=_chain_limits(joints, moving),
-        info={'source': label, 'urdf': report,
-              # friction, offset, rotor inertia (or None)
-              'drives': read_drives(_parse(text, _Source(label)), moving,
-                                    label)})
-    return model, _tree_warnings(label, links, joints, bodies), report
+                                      label, prior, notes))
+        return model, _prior_note(label, notes) + found, report
+    model, found, report = chain_model(
+        name, label, links, joints, (root, base, tip), gravity,
+        lambda names: _chain_limits(joints, names),
+        lambda names: read_drives(_parse(text, _Source(label)), names,
+                                  label, prior, notes))
+    return model, _prior_note(label, notes) + found, report
+
+
+def _prior_note(label, notes):
+    if not notes:
+        return []
+    return [Note(f'{label}: physically impossible values accepted as the '
+                 f'prior of an identification (the fit makes every link '
+                 f'physical and its friction >= 0; nothing else reads such '
+                 f'a file): ' + _short('; '.join(notes), 600))]
 
 
 def inspect_urdf(text_or_path, base=None, tip=None, label=None,
-                 gravity=(0.0, 0.0, -9.81)):
+                 gravity=(0.0, 0.0, -9.81), prior=False):
     """Load a URDF (text or path); return (model, warnings, report)."""
     text, label = read_urdf_text(text_or_path, label)
-    return urdf_model(text, label, base=base, tip=tip, gravity=gravity)
+    return urdf_model(text, label, base=base, tip=tip, gravity=gravity,
+                      prior=prior)
 
 
 def load_urdf(text_or_path, base=None, tip=None, gravity=(0.0, 0.0, -9.81)):

@@ -28,7 +28,13 @@ import numpy as np
 
 from .errors import RobotFileError
 from .inertia import merge_bodies
+from .model import PRISMATIC, REVOLUTE
 from .text import clip
+
+
+#: the URDF joint types that are joints of a model, and their kind
+MOVING = {'revolute': REVOLUTE, 'continuous': REVOLUTE,
+          'prismatic': PRISMATIC}
 
 
 def _short(text, limit=200):
@@ -95,6 +101,20 @@ def attached(links, joints, start, stop_joints, pose=np.eye(4)):
             Tc = T @ joint.origin @ axis_motion(joint.kind, joint.axis, q)
             out.append((joint.child, Tc, jname))
             stack.append((joint.child, Tc))
+    return out
+
+
+def fixed_above(links, joints, base):
+    """Links above ``base`` joined to it by fixed joints: {name: pose}."""
+    out = {}
+    lname, T = base, np.eye(4)
+    while links[lname].parent_joint is not None:
+        joint = joints[links[lname].parent_joint]
+        if joint.kind != 'fixed':
+            break
+        T = T @ np.linalg.inv(joint.origin)
+        lname = joint.parent
+        out[lname] = T
     return out
 
 

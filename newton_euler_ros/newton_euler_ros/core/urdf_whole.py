@@ -38,21 +38,9 @@ import numpy as np
 
 from .errors import RobotFileError
 from .inertia import triangle_note
-from .model import make_chain, PRISMATIC, REVOLUTE
+from .model import make_chain
 from .text import clip
-from .urdf_tree import combine
-
-MOVING = {'revolute': REVOLUTE, 'continuous': REVOLUTE,
-          'prismatic': PRISMATIC}
-
-
-def _origin_ops(joint):
-    ops = []
-    if any(joint.xyz):
-        ops.append(('xyz',) + tuple(joint.xyz))
-    if any(joint.rpy):
-        ops.append(('rpy',) + tuple(joint.rpy))
-    return ops
+from .urdf_tree import combine, fixed_above, MOVING
 
 
 class _Walk:
@@ -95,11 +83,11 @@ class _Walk:
             part = (joint.child, Tc, jname)
             (self.base_parts if body < 0 else self.parts[body]).append(part)
             self.frames[joint.child] = (body, Tc)
-            return joint.child, body, tuple(ops) + tuple(_origin_ops(joint)), Tc
+            return joint.child, body, tuple(ops) + tuple(joint.origin_ops), Tc
         k = len(self.moving)
         self.moving.append(jname)
         self.parents.append(body)
-        self.pre.append(tuple(ops) + tuple(_origin_ops(joint)))
+        self.pre.append(tuple(ops) + tuple(joint.origin_ops))
         self.parts.append([(joint.child, np.eye(4), jname)])
         self.frames[joint.child] = (k, np.eye(4))
         return joint.child, k, (), np.eye(4)
@@ -142,20 +130,6 @@ def _tool(links, joints, walk, base):
     return body, T, leaves[0]
 
 
-def _above_base(links, joints, base):
-    """Links above the base joined to it by fixed joints, in base frame."""
-    out = {}
-    lname, T = base, np.eye(4)
-    while links[lname].parent_joint is not None:
-        joint = joints[links[lname].parent_joint]
-        if joint.kind != 'fixed':
-            break
-        T = T @ np.linalg.inv(joint.origin)
-        lname = joint.parent
-        out[lname] = T
-    return out
-
-
 def _notes(label, links, joints, walk):
     found = []
     massless = []
@@ -190,7 +164,7 @@ def tree_model(name, label, links, joints, base, gravity, limits, drives):
     bodies = [combine(parts, links) for parts in walk.parts]
     tool_body, tool, tip = _tool(links, joints, walk, base)
     frames = dict(walk.frames)
-    for lname, T in _above_base(links, joints, base).items():
+    for lname, T in fixed_above(links, joints, base).items():
         frames[lname] = (-1, T)
     independent = [n for n, m in zip(walk.moving, mimic) if m is None]
     tip_frames = {}

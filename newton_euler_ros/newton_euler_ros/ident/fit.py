@@ -13,42 +13,53 @@
 # limitations under the License.
 
 """
-Fit inertial and drive parameters to a recording, physically consistent.
+Fit inertial and drive parameters to recordings, physically consistent.
 
 The parameters theta = [pi (10n, per link), drives (4n, per joint)] enter
 the torques linearly, tau = Y theta (``core.regressor`` with
-``drives=True``).  The pipeline:
+``drives=True``); when the efforts are motor currents, tau_j = K_j e_j
+with a torque constant per joint.  The pipeline:
 
-1. Stream the bag in chunks (``bag.iter_joint_states``), prepare windows
-   of it (``signals.prepare``: resample, zero-phase filter, differentiate,
-   same filter on the effort, edges dropped; windows overlap by the
-   filter's edge so nothing is lost between them), keep every k-th sample
-   so that the fit rate is about ``FIT_RATE_FACTOR`` times the cutoff
-   (the filtered signals carry nothing above the cutoff).
-2. Accumulate, per joint j, the R factor of the augmented matrix
-   [Y_j | y_j] over the chunks (:class:`Reduced`): (14n + 1)^2 numbers
-   whatever the recording's length, and from it exactly the residual
-   ||y_j - Y_j theta||^2 of any theta.  Time blocks of ``BLOCK_S`` seconds
-   (shorter for a short recording) alternate between a training and a
-   held-out part (one in ``HOLDOUT_EVERY``).
+1. Read, prepare and reduce each recording (``reduce``, ``problem``):
+   per joint, the R factor of its rows, (p + 1)^2 numbers whatever the
+   recording's length; a training part and held-out time blocks from
+   each recording; every Coulomb width candidate among the columns.
+2. What the efforts are (``effort``): per joint, the least-squares ratio
+   of the nominal model's torque to the effort.  Torques must give about
+   1, else the command stops and points to ``--effort current``.
 3. Weights: each joint's rows by 1 / sigma_j, sigma_j the RMS residual of
-   an unconstrained least-squares fit on the training part (weighted least
-   squares, Gautier & Poignet): small wrist torques count as much as the
-   shoulder's.
+   an unconstrained least-squares fit on the training parts (weighted
+   least squares, Gautier & Poignet): small wrist torques count as much
+   as the shoulder's.
 4. Base parameters (``base.base_parameters``): the rank and condition
-   number of the weighted regressor; a recording whose rank is far below
-   the structural count does not excite the arm and is refused.
-5. A semidefinite program (CVXPY, solved by Clarabel): minimise the mean
-   weighted squared residual plus lambda ||D (theta - theta_0)||^2 toward
-   the nominal model theta_0, with every link's 4x4 pseudo-inertia
-   positive semi-definite (Wensing, Kim & Slotine 2018), viscous and
-   Coulomb friction and armature >= 0.  D scales each parameter by its
-   column's RMS in the weighted regressor, so lambda is a fraction of what
-   a change costs in the data where the data sees it.  Parameters the
-   recording does not excite stay at the prior.  lambda is chosen on the
-   held-out part over ``LAMBDAS``: the largest lambda whose held-out error
-   is within ``LAMBDA_SLACK`` of the best.  The final fit uses all the
-   data with that lambda.
+   number of the weighted regressor; recordings whose rank is far below
+   the structural count do not excite the arm and are refused.
+5. A semidefinite program (``sdp``: CVXPY, solved by Clarabel, every
+   variable scaled to order one): minimise the mean weighted squared
+   residual plus lambda ||D (theta - theta_0)||^2 toward the nominal
+   model theta_0, with every link's 4x4 pseudo-inertia positive
+   semi-definite (Wensing, Kim & Slotine 2018), viscous and Coulomb
+   friction and armature >= 0.  D scales each parameter by its column's
+   RMS in the weighted regressor, so lambda is a fraction of what a
+   change costs in the data where the data sees it.  Parameters the
+   recordings do not excite stay at the prior.
+6. Hyperparameters on the held-out blocks: lambda over ``LAMBDAS`` (the
+   largest whose held-out error is within ``LAMBDA_SLACK`` of the best),
+   then the Coulomb width over ``WIDTHS`` at that lambda (the default
+   kept unless another is better by ``WIDTH_SLACK``), then lambda again
+   for that width.  The final fit uses all the data.
+
+**Torque constants** (``effort='current'``).  The rows K_j e_j = Y_j theta
+are homogeneous: K and theta scaled together fit equally well, so
+something must fix the scale.  By default the nominal model's masses
+and gravity: the D^2-weighted projection of theta's inertial part on the
+nominal's is held at the nominal's value (the data decides the shape,
+the nominal model the overall size, where gravity sees it).  With a
+recording of a known mass at the tip (its centre of mass and inertia
+unknown, a PSD body of that mass), the mass fixes the scale instead: the
+payload's torque is exactly known up to its centre of mass and inertia,
+the arm's parameters are shared with the other recordings.  Torque
+constants given in the nominal URDF are used as given.
 
 Links carrying rigidly attached children (a URDF's fixed joints and locked
 off-chain subtrees: a hand, fingers) are constrained as the link's own
@@ -60,252 +71,45 @@ import time
 
 import numpy as np
 
-from .bag import (BagError, DEFAULT_TOPIC, iter_joint_states,
-                  recording_seconds)
+from . import effort as effort_units
+from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
-from .signals import default_cutoff, edge_samples, prepare, sample_rate
+from .constants import fit_constants, mass_excitation
+from .problem import (joint_stats, Layout, Recording, recording_rows,
+                      stacked)
+from .reduce import IdentificationError, reduce_recording
+from .sdp import body_scale, INACCURATE, objective_scale, ScaledBody, solve
 from ..core.drives import DEFAULT_COULOMB_WIDTH, Drives, model_drives
 from ..core.regressor import (inertial_parameters, N_DRIVE, N_INERTIAL,
-                              regressor_batch, with_parameters)
+                              with_parameters)
 
-BLOCK_S = 4.0
-HOLDOUT_EVERY = 5
-FIT_RATE_FACTOR = 10.0
 LAMBDAS = tuple(10.0 ** k for k in range(-8, 1))
 LAMBDA_SLACK = 0.02
+WIDTHS = (0.005, 0.01, 0.02, 0.05, 0.1)
+WIDTH_SLACK = 0.01
 # a recording whose rank is below this fraction of the structural count
 # does not excite the arm
 MIN_RANK_FRACTION = 0.5
-STATE_CHUNK = 4096
-READ_CHUNK = 32768
-
-
-class IdentificationError(BagError):
-    """The recording cannot give a model (one line naming the bag)."""
-
-
-class Reduced:
-    """
-    Per joint, the R factor of [Y_j | y_j] accumulated over chunks.
-
-    ``R[j]`` is (at most) (p + 1) x (p + 1) upper triangular; the residual
-    of any theta on joint j's rows is ||R[j] [theta; -1]||, and the
-    effort's squared norm is ||R[j][:, p]||^2.
-    """
-
-    def __init__(self, n, p):
-        self.n = n
-        self.p = p
-        self.R = [np.zeros((0, p + 1)) for _ in range(n)]
-        self.rows = np.zeros(n, dtype=np.int64)
-
-    def add(self, Y, tau):
-        """Add (m, n, p) regressor rows and (m, n) torques."""
-        m = Y.shape[0]
-        if m == 0:
-            return
-        for j in range(self.n):
-            A = np.empty((m + self.R[j].shape[0], self.p + 1))
-            A[:m, :self.p] = Y[:, j, :]
-            A[:m, self.p] = tau[:, j]
-            A[m:] = self.R[j]
-            self.R[j] = np.linalg.qr(A, mode='r')
-        self.rows += m
-
-    def merged(self, other):
-        """Return the reduction of both sets of rows."""
-        out = Reduced(self.n, self.p)
-        for j in range(self.n):
-            out.R[j] = np.linalg.qr(np.vstack([self.R[j], other.R[j]]),
-                                    mode='r')
-        out.rows = self.rows + other.rows
-        return out
-
-    def sq_residuals(self, theta):
-        """(n,) squared residual norms of theta, per joint."""
-        x = np.append(theta, -1.0)
-        return np.array([float(np.sum((Rj @ x) ** 2)) for Rj in self.R])
-
-    def sq_effort(self):
-        """(n,) squared norms of the measured torques, per joint."""
-        return np.array([float(np.sum(Rj[:, self.p] ** 2))
-                         for Rj in self.R])
-
-    def stats(self, theta):
-        """Return (rms, relative rms) per joint of the residual of theta."""
-        rows = np.maximum(self.rows, 1)
-        rms = np.sqrt(self.sq_residuals(theta) / rows)
-        ref = np.sqrt(self.sq_effort() / rows)
-        return rms, rms / np.maximum(ref, 1e-300)
-
-    def stacked(self, weights):
-        """Weighted [Y | y] rows of all joints (reduced), (<= n(p+1), p+1)."""
-        return np.vstack([Rj * w for Rj, w in zip(self.R, weights)])
-
-
-# ---------------------------------------------------------------------------
-# from the bag to reduced problems
-
-def prepared_windows(path, joint_names, topic=DEFAULT_TOPIC, cutoff=None,
-                     window=READ_CHUNK):
-    """
-    Yield ``signals.Prepared`` windows of the recording, in order.
-
-    Windows overlap by twice the filter's edge in raw samples, and the
-    samples of a window at or before the last one yielded are dropped, so
-    the windows tile the recording once.
-    """
-    tail = None
-    rate = None
-    last_t = -np.inf
-    for chunk in iter_joint_states(path, joint_names, topic, chunk=window):
-        parts = [chunk] if tail is None else [tail, chunk]
-        stamps = np.concatenate([p.stamps for p in parts])
-        q = np.concatenate([p.q for p in parts])
-        qd = None if any(p.qd is None for p in parts) else np.concatenate(
-            [p.qd for p in parts])
-        e = np.concatenate([p.effort for p in parts])
-        if rate is None:
-            rate = sample_rate(stamps)
-            cutoff = default_cutoff(rate) if cutoff is None else cutoff
-            edge = edge_samples(rate, cutoff)
-        piece = prepare(stamps, q, qd, e, rate=rate, cutoff=cutoff,
-                        edge=edge)
-        keep = 2 * edge + 4
-        tail = _Tail(stamps[-keep:], q[-keep:],
-                     None if qd is None else qd[-keep:], e[-keep:])
-        if piece is None:
-            continue
-        new = piece.t > last_t + 0.5 / rate
-        if not new.any():
-            continue
-        last_t = piece.t[new][-1]
-        for key in ('t', 'q', 'qd', 'qdd', 'effort'):
-            setattr(piece, key, getattr(piece, key)[new])
-        yield piece
-
-
-@dataclass
-class _Tail:
-    stamps: np.ndarray
-    q: np.ndarray
-    qd: object
-    effort: np.ndarray
-
-
-def _decimation(rate, cutoff):
-    return max(1, int(rate / (FIT_RATE_FACTOR * cutoff)))
+# a known mass whose torque changes by less than this many residual RMS on
+# every joint does not fix the torque constants (constants.mass_excitation)
+KNOWN_MASS_EXCITATION = 0.5
+PAYLOAD_PRIOR = 1e-6
 
 
 def accumulate(model, path, topic=DEFAULT_TOPIC, coulomb_width=None,
                cutoff=None, split=True):
     """
-    Reduce a recording: return (train, held_out or None, info dict).
+    Reduce a recording to the regressor's problem (``reduce``).
 
-    With ``split=False`` every block goes to ``train``.  Blocks are
-    ``BLOCK_S`` long, shorter for a recording under ten blocks (down to
-    half a second), so that even a short one has a held-out part.
+    Return (train, held_out or None, info dict): the rows of the torque
+    regressor with drive terms (Coulomb width ``coulomb_width``) against
+    the effort.
     """
-    block_s = BLOCK_S
-    if split:
-        block_s = min(BLOCK_S, max(0.5, recording_seconds(path) / 10.0))
     eps = DEFAULT_COULOMB_WIDTH if coulomb_width is None else coulomb_width
-    p = model.n * (N_INERTIAL + N_DRIVE)
-    train = Reduced(model.n, p)
-    held = Reduced(model.n, p) if split else None
-    samples = 0
-    info = {'rate': None, 'cutoff': None, 'duration': 0.0}
-    t_first = None
-    for piece in prepared_windows(path, model.joint_names, topic, cutoff):
-        if info['rate'] is None:
-            info['rate'], info['cutoff'] = piece.rate, piece.cutoff
-            step = _decimation(piece.rate, piece.cutoff)
-            info['step'] = step
-        if t_first is None:
-            t_first = piece.t[0]
-        info['duration'] = piece.t[-1] - t_first
-        idx = np.arange(0, len(piece), step)
-        samples += len(piece)
-        for a in range(0, len(idx), STATE_CHUNK):
-            sel = idx[a:a + STATE_CHUNK]
-            Y = regressor_batch(model, piece.q[sel], piece.qd[sel],
-                                piece.qdd[sel], drives=True,
-                                coulomb_width=eps)
-            tau = piece.effort[sel]
-            if held is None:
-                train.add(Y, tau)
-                continue
-            block = np.floor((piece.t[sel] - t_first) / block_s)
-            out = (block % HOLDOUT_EVERY) == HOLDOUT_EVERY - 1
-            train.add(Y[~out], tau[~out])
-            held.add(Y[out], tau[out])
-    info['samples'] = samples
-    if samples == 0:
-        raise IdentificationError(
-            f'{path}: too short: nothing is left after filtering (needs '
-            f'more than a few tenths of a second of samples without gaps)')
-    return train, held, info
-
-
-# ---------------------------------------------------------------------------
-# the semidefinite program
-
-def _pi_of_pseudo(J):
-    """Return the 10 parameters (cvxpy expressions) of a pseudo-inertia."""
-    return [J[3, 3], J[0, 3], J[1, 3], J[2, 3],
-            J[1, 1] + J[2, 2], -J[0, 1], J[0, 0] + J[2, 2], -J[0, 2],
-            -J[1, 2], J[0, 0] + J[1, 1]]
-
-
-class _Program:
-    """The SDP, compiled once, solved for any data and lambda."""
-
-    def __init__(self, n, fixed, theta0, D):
-        import cvxpy as cp
-        self.cp = cp
-        p = n * (N_INERTIAL + N_DRIVE)
-        self.R = cp.Parameter((p, p))
-        self.z = cp.Parameter(p)
-        self.sl = cp.Parameter(nonneg=True)
-        self.J = [cp.Variable((4, 4), PSD=True) for _ in range(n)]
-        self.d = cp.Variable(N_DRIVE * n)
-        parts = []
-        for k in range(n):
-            parts += [fixed[k, i] + e for i, e in
-                      enumerate(_pi_of_pseudo(self.J[k]))]
-        self.theta = cp.hstack(parts + [self.d])
-        j = np.arange(n) * N_DRIVE
-        cons = [self.d[j] >= 0, self.d[j + 1] >= 0, self.d[j + 3] >= 0]
-        obj = cp.sum_squares(self.R @ self.theta - self.z) + cp.sum_squares(
-            self.sl * cp.multiply(D, self.theta - theta0))
-        self.problem = cp.Problem(cp.Minimize(obj), cons)
-
-    def solve(self, R, z, lam):
-        cp = self.cp
-        self.R.value = R
-        self.z.value = z
-        self.sl.value = float(np.sqrt(lam))
-        try:
-            self.problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError:
-            return None
-        if self.problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-            return None
-        return np.asarray(self.theta.value, dtype=np.float64)
-
-
-def _square(red, weights):
-    """Weighted, normalised square problem (R p x p, z p) of a Reduced."""
-    A = red.stacked(weights)
-    Rf = np.linalg.qr(A, mode='r')
-    p = red.p
-    Rp = np.zeros((p, p))
-    zp = np.zeros(p)
-    k = min(Rf.shape[0], p)
-    Rp[:k] = Rf[:k, :p]
-    zp[:k] = Rf[:k, p]
-    scale = 1.0 / np.sqrt(max(int(red.rows.sum()), 1))
-    return Rp * scale, zp * scale
+    layout = Layout(model.n, (eps,))
+    return reduce_recording(path, model.joint_names,
+                            recording_rows(model, layout, False),
+                            layout.bag_columns(False), topic, cutoff, split)
 
 
 def nominal_theta(model, coulomb_width=None):
@@ -315,7 +119,7 @@ def nominal_theta(model, coulomb_width=None):
     return np.concatenate([inertial_parameters(model), d])
 
 
-def fixed_parts(model, urdf_text=None):
+def fixed_parts(model, urdf_text=None, prior=False):
     """
     (n, 10): nominal parameters of the parts rigidly attached to each link.
 
@@ -331,7 +135,7 @@ def fixed_parts(model, urdf_text=None):
         return out
     from ..core.regressor import link_parameters
     from ..core.urdf import parse_urdf
-    _, _, links, _ = parse_urdf(urdf_text)
+    _, _, links, _ = parse_urdf(urdf_text, prior=prior)
     total = inertial_parameters(model).reshape(n, N_INERTIAL)
     for k, lname in enumerate(report['links']):
         lk = links[lname]
@@ -360,100 +164,380 @@ class Result:
     seconds: float = 0.0
     validate_seconds: float = 0.0
     lambda_errors: list = field(default_factory=list)
+    width_errors: list = field(default_factory=list)
+    recordings: list = field(default_factory=list)   # (path, info)
+    torque_constant: np.ndarray = None   # N m per effort unit, or None
+    constants: str = 'none'     # 'none', 'given', 'identified'
+    ratios: dict = field(default_factory=dict)   # bag: (K, explained)
+    payload: dict = None        # the known mass's identified body
+    mass_excitation: np.ndarray = None   # constants.mass_excitation
+    notes: list = field(default_factory=list)
+    undetermined_k: list = field(default_factory=list)  # joint indices
 
 
-def _weights(red):
-    """1 / sigma_j from an unconstrained least-squares fit."""
-    A = red.stacked(np.ones(red.n))
-    theta, *_ = np.linalg.lstsq(A[:, :-1], A[:, -1], rcond=1e-10)
-    rows = np.maximum(red.rows, 1)
-    sigma = np.sqrt(red.sq_residuals(theta) / rows)
-    ref = np.sqrt(red.sq_effort() / rows)
-    sigma = np.maximum(sigma, np.maximum(1e-3 * ref, 1e-6))
-    return sigma
+class _Program:
+    """The SDP, compiled once, solved for any data and lambda."""
+
+    def __init__(self, layout, fixed, theta0, D, scales, mass=None):
+        import cvxpy as cp
+        n = layout.n
+        d = layout.size
+        self.layout = layout
+        self.R = cp.Parameter((d, d))
+        self.z = cp.Parameter(d)
+        self.sl = cp.Parameter(nonneg=True)
+        self.sl_pay = cp.Parameter(nonneg=True)
+        self.bodies = [ScaledBody(cp, *scales['bodies'][k])
+                       for k in range(n)]
+        self.dt = cp.Variable(N_DRIVE * n)
+        parts = []
+        for k, body in enumerate(self.bodies):
+            parts += [fixed[k, i] + e for i, e in enumerate(body.params)]
+        theta = cp.hstack(parts + [cp.multiply(scales['drives'], self.dt)])
+        x = [theta]
+        j = np.arange(n) * N_DRIVE
+        cons = [self.dt[j] >= 0, self.dt[j + 1] >= 0, self.dt[j + 3] >= 0]
+        obj = cp.sum_squares(self.sl * cp.multiply(D, theta - theta0))
+        if layout.pay is not None:
+            pay = ScaledBody(cp, mass, 0.1)
+            x.append(cp.hstack(pay.params))
+            cons.append(pay.params[0] == mass)
+            # a faint pull of what the motion does not excite to zero,
+            # scaled with the data like the prior
+            obj += cp.sum_squares(self.sl_pay * cp.multiply(
+                scales['payload'], cp.hstack(pay.params[1:])))
+        self.x = cp.hstack(x) if len(x) > 1 else theta
+        obj += cp.sum_squares(self.R @ self.x - self.z)
+        self.problem = cp.Problem(cp.Minimize(obj), cons)
+        self.trouble = []
+
+    def solve(self, Aug, lam, label=''):
+        """Return x (or None) for the square problem Aug and lambda."""
+        d = self.layout.size
+        for more in (1.0, 30.0):    # once more, larger, if it stops early
+            f = more * objective_scale(Aug)
+            self.R.value = f * Aug[:d, :d]
+            self.z.value = f * Aug[:d, d]
+            self.sl.value = f * float(np.sqrt(lam))
+            self.sl_pay.value = f * float(np.sqrt(PAYLOAD_PRIOR))
+            result = solve(self.problem, label)
+            if result.status != 'inaccurate':
+                break
+        if result.status == 'inaccurate':
+            self.trouble.append(label)
+        if not result.ok:
+            return None
+        return np.asarray(self.x.value, dtype=np.float64)
+
+
+def _error(Aug, x):
+    v = Aug @ np.append(x, -1.0)
+    return float(v @ v)
+
+
+def _weights(recordings, layout, k0):
+    """Return sigma_j (N m): the residual of an unconstrained fit at k0."""
+    ones = np.ones(layout.n)
+    Aug, _ = stacked(recordings, 'train', layout, 0, ones, k0)
+    d = layout.size
+    x, *_ = np.linalg.lstsq(Aug[:d, :d], Aug[:d, d], rcond=1e-10)
+    rms, rel = joint_stats(recordings, 'train', layout, 0, x, k0, k0)
+    ref = rms / np.maximum(rel, 1e-300)
+    return np.maximum(rms, np.maximum(1e-3 * ref, 1e-6))
+
+
+def _scales(model, theta0, D, layout, mass, Aall):
+    """Typical sizes of the unknowns (``sdp``: solve in units of them)."""
+    n = model.n
+    pi0 = theta0[:N_INERTIAL * n].reshape(n, N_INERTIAL)
+    bodies = [body_scale(pi0[k]) for k in range(n)]
+    Dd = D[N_INERTIAL * n:layout.p_theta]
+    drives = 1.0 / np.maximum(Dd, 1e-12 * max(float(Dd.max()), 1e-300))
+    payload = None
+    if mass is not None:    # the payload's columns' norms (its prior)
+        Dp = np.linalg.norm(Aall[:, layout.pay.start + 1:layout.pay.stop],
+                            axis=0)
+        payload = np.maximum(Dp, 1e-3 * max(float(np.median(Dp)), 1e-12))
+    return {'bodies': bodies, 'drives': drives, 'payload': payload}
+
+
+def _reduce_all(model, layout, bags, known, topic, cutoff):
+    recordings = []
+    for path, mass in [(b, None) for b in bags] + list(known):
+        loaded = mass is not None
+        train, held, info = reduce_recording(
+            path, model.joint_names, recording_rows(model, layout, loaded),
+            layout.bag_columns(loaded), topic, cutoff)
+        info['held_samples'] = 0 if held is None else int(held.rows.max())
+        recordings.append(Recording(str(path), train, held, info, mass))
+    return recordings
+
+
+def _ratios(recordings, layout, theta):
+    """Per bag (K, explained) of ``effort.ratios`` for the model theta."""
+    out = {}
+    for rec in recordings:
+        red = rec.part('all')
+        u = np.zeros(red.p)
+        u[:layout.p_theta] = theta
+        if rec.loaded:      # the known mass as a point at the tip
+            u[layout.bag_columns(False)] = rec.mass
+        out[rec.path] = effort_units.ratios(red, u, layout.drive_columns)
+    return out
+
+
+def _check_units(recordings, layout, theta0, model, mode, k_given, urdf):
+    """Per bag (K, explained); IdentificationError when impossible."""
+    out = _ratios(recordings, layout, theta0)
+    for path, (K, explained) in out.items():
+        if k_given is not None:
+            K = K / k_given
+        effort_units.check(path, model.joint_names, K, explained, mode,
+                           urdf)
+    return out
+
+
+def _scale_pin(ratios, k0):
+    """
+    Weights c (sum 1) of the joints whose constants' mean fixes the scale.
+
+    The joints where the nominal model explains the effort (``effort``:
+    gravity-loaded joints) count by how well it does: the data fixes the
+    constants relative to each other, the nominal model's masses and
+    gravity their mean (``constants.fit_constants``).
+    """
+    c = np.zeros(len(k0))
+    for k, e in ratios.values():
+        c += np.where((e >= effort_units.MIN_EXPLAINED) & (k > 0), e, 0.0)
+    return c / c.sum()
+
+
+def _check_mass(recording, layout, sigma):
+    """Raise IdentificationError when the known mass's torque never changes."""
+    excited = mass_excitation(recording, layout, sigma)
+    if excited.max() < KNOWN_MASS_EXCITATION:
+        raise IdentificationError(
+            f'{recording.path}: the recording does not excite the known '
+            f'{recording.mass:g} kg mass: its torque changes by at most '
+            f'{excited.max():.2g} residual RMS on any joint beyond what the '
+            f'drive terms explain (move the loaded arm through poses where '
+            f'gravity acts on it differently: the shoulder and elbow '
+            f'moving)')
+    return excited
+
+
+def _determined(ratios, n):
+    """Joints whose effort follows the nominal model's rigid-body torque."""
+    out = np.zeros(n, dtype=bool)
+    for k, e in ratios.values():
+        out |= (e >= effort_units.MIN_EXPLAINED) & (k > 0)
+    return out
+
+
+def _initial_constants(ratios, n):
+    """
+    Each determined joint's ratio (weighted over the bags), else their mean.
+
+    Raises IdentificationError when no joint is determined.
+    """
+    K = np.zeros(n)
+    good = np.zeros(n)
+    for k, e in ratios.values():
+        use = (e >= effort_units.MIN_EXPLAINED) & (k > 0)
+        K += np.where(use, k * e, 0.0)
+        good += np.where(use, e, 0.0)
+    if not good.any():
+        raise IdentificationError(
+            f"{next(iter(ratios))}: no joint's effort follows the nominal "
+            f"model's torque, so the torque constants cannot be found "
+            f'(record the shoulder and elbow moving against gravity, or '
+            f'give the constants in the URDF)')
+    K = np.where(good > 0, K / np.maximum(good, 1e-300), np.nan)
+    return np.where(np.isnan(K), np.nanmean(K), K)
 
 
 def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
-             coulomb_width=None, cutoff=None, urdf_text=None):
+             coulomb_width=None, cutoff=None, urdf_text=None,
+             effort='torque', known_mass=None, urdf_label=None):
     """
-    Identify ``model``'s parameters from the bag at ``path``.
+    Identify ``model``'s parameters from the bag(s) at ``path``.
 
-    Returns a :class:`Result` whose ``model`` carries the identified
-    inertials and ``drives`` the identified drive terms.  Raises
-    :class:`BagError` (or :class:`IdentificationError`) with one line.
+    ``path`` is one bag or a list of them, fitted together (held-out
+    blocks from each).  ``effort`` 'torque' (N m) or 'current'
+    (proportional to torque: the torque constants are identified, unless
+    the nominal URDF gives them); ``known_mass`` None or (bag, kg): a
+    recording with that mass added at the tip.  Returns a
+    :class:`Result` whose ``model`` carries the identified inertials and
+    ``drives`` the identified drive terms (with ``torque_constant``).
+    Raises :class:`BagError` (or :class:`IdentificationError`) with one
+    line.
     """
     start = time.perf_counter()
+    bags = [path] if isinstance(path, (str, bytes)) or not hasattr(
+        path, '__iter__') else list(path)
     nominal = model_drives(model)
-    if coulomb_width is None:
-        coulomb_width = (float(nominal.coulomb_width[0])
-                         if nominal is not None else DEFAULT_COULOMB_WIDTH)
-    eps = float(coulomb_width)
+    k_given = None if nominal is None else nominal.torque_constant
+    estimate_k = effort == 'current' and k_given is None
+    known = [] if known_mass is None else [tuple(known_mass)]
+    w0 = (float(nominal.coulomb_width[0]) if nominal is not None
+          else DEFAULT_COULOMB_WIDTH)
+    widths = ((float(coulomb_width),) if coulomb_width is not None else
+              (w0,) + tuple(w for w in WIDTHS if abs(w - w0) > 1e-12))
     n = model.n
+    layout = Layout(n, widths, bool(known))
     theta0 = nominal_theta(model)
-    fixed = fixed_parts(model, urdf_text)
-    train, held, info = accumulate(model, path, topic, eps, cutoff)
-    if held.rows.min() == 0:
-        # too short to hold a block out: fit and choose on the same data
-        held = train
-    sigma = _weights(train)
-    w = 1.0 / sigma
-    everything = train.merged(held) if held is not train else train
-    Rall, zall = _square(everything, w)
-    base = base_parameters(Rall)
+    fixed = fixed_parts(model, urdf_text, prior=True)
+    recordings = _reduce_all(model, layout, bags, known, topic, cutoff)
+    mode = ('current' if estimate_k else 'given' if k_given is not None
+            else 'torque')
+    ratios = _check_units(recordings, layout, theta0, model, mode, k_given,
+                          urdf_label)
+    k0 = (_initial_constants(ratios, n) if estimate_k else
+          k_given if k_given is not None else np.ones(n))
+    sigma_e = _weights(recordings, layout, k0) / k0
+    w = 1.0 / (sigma_e * k0)
+    excited = (_check_mass(recordings[-1], layout, sigma_e * k0)
+               if estimate_k and known else None)
+    Aall, _ = stacked(recordings, 'all', layout, 0, w, k0)
+    base = base_parameters(Aall[:layout.p_theta, :layout.p_theta])
     struct = structural_base(model, drives=True)
     if base.rank < MIN_RANK_FRACTION * struct.rank:
         raise IdentificationError(
-            f'{path}: the recording does not excite the arm: rank '
-            f'{base.rank} of the regressor against {struct.rank} base '
+            f'{recordings[0].path}: the recording does not excite the arm: '
+            f'rank {base.rank} of the regressor against {struct.rank} base '
             f'parameters (move every joint, with varied speeds and '
             f'accelerations)')
-    Rt, zt = _square(train, w)
-    D = np.linalg.norm(Rall, axis=0)
+    D = np.linalg.norm(Aall[:, :layout.p_theta], axis=0)
     D = np.maximum(D, 1e-3 * max(float(np.median(D)), 1e-12))
-    program = _Program(n, fixed, theta0, D)
-    errors = []
-    for lam in LAMBDAS:
-        theta = program.solve(Rt, zt, lam)
-        if theta is None:
-            continue
-        err = float(np.sum(held.sq_residuals(theta) * w ** 2)
-                    / max(int(held.rows.sum()), 1))
-        errors.append((lam, err))
-    if not errors:
-        raise IdentificationError(f'{path}: the fit failed (the solver '
-                                  f'found no solution)')
-    best = min(e for _, e in errors)
-    lam = max(lam for lam, e in errors if e <= best * (1 + LAMBDA_SLACK))
-    theta = program.solve(Rall, zall, lam)
-    if theta is None:
-        raise IdentificationError(f'{path}: the fit failed (the solver '
-                                  f'found no solution)')
-    # the SDP's answer is PSD to the solver's tolerance: clip round-off
-    theta = _clean(theta, fixed, n)
+    mass = known[0][1] if known else None
+    program = _Program(layout, fixed, theta0, D,
+                       _scales(model, theta0, D, layout, mass, Aall), mass)
+    lam, width, lam_errors, width_errors = _choose(
+        program, recordings, layout, w, k0)
+    K, free = k0, None
+    if estimate_k:
+        # the joints whose effort the first fit's rigid-body torque explains
+        Aall, _ = stacked(recordings, 'all', layout, width, w, k0)
+        x = program.solve(Aall, lam, 'first fit')
+        free = _determined(ratios, n)
+        if x is not None:
+            free |= _determined(_ratios(recordings, layout,
+                                        x[:layout.p_theta]), n)
+        K = fit_constants(
+            recordings, layout, width, sigma_e, k0, lam, D, theta0, free,
+            None if known else _scale_pin(ratios, k0), mass)
+        w = 1.0 / (sigma_e * K)
+    Aall, _ = stacked(recordings, 'all', layout, width, w, K)
+    x = program.solve(Aall, lam, 'final')
+    if x is None:
+        raise IdentificationError(f'{recordings[0].path}: the fit failed '
+                                  f'(the solver found no solution)')
+    eps = widths[width]
+    theta = _clean(x[:layout.p_theta], fixed, n)
+    x[:layout.p_theta] = theta
+    K_out = K if (estimate_k or k_given is not None) else None
+    drives = Drives.from_parameters(theta[N_INERTIAL * n:], eps, K_out)
     ident = with_parameters(model, theta[:N_INERTIAL * n])
-    drives = Drives.from_parameters(theta[N_INERTIAL * n:], eps)
     info_ = dict(model.info or {})
     info_['drives'] = drives
     ident = ident.replace(info=info_)
     result = Result(
         model=ident, theta=theta, theta0=theta0, drives=drives,
         coulomb_width=eps, rank=base.rank, structural_rank=struct.rank,
-        condition=base.condition, lam=lam, sigma=sigma, info=info,
-        lambda_errors=errors)
-    result.fit_stats = {'nominal': everything.stats(theta0),
-                        'identified': everything.stats(theta)}
-    if held is not train:
-        result.fit_stats['held_out_nominal'] = held.stats(theta0)
-        result.fit_stats['held_out_identified'] = held.stats(theta)
+        condition=base.condition, lam=lam, sigma=sigma_e * K,
+        info=recordings[0].info, lambda_errors=lam_errors,
+        width_errors=width_errors, torque_constant=K_out, ratios=ratios,
+        constants=('identified' if estimate_k else 'given'
+                   if k_given is not None else 'none'),
+        recordings=[(r.path, r.info) for r in recordings],
+        undetermined_k=([] if free is None
+                        else [int(j) for j in np.flatnonzero(~free)]),
+        mass_excitation=excited)
+    _report(result, recordings, layout, width, x, K, known, program)
     result.seconds = time.perf_counter() - start
     if validate is not None:
-        val, _, vinfo = accumulate(model, validate, topic, eps, cutoff,
-                                   split=False)
-        result.validate_stats = {'nominal': val.stats(theta0),
-                                 'identified': val.stats(theta)}
+        val = reduce_recording(validate, model.joint_names,
+                               recording_rows(model, layout, False),
+                               layout.bag_columns(False), topic, cutoff,
+                               split=False)
+        rec = Recording(str(validate), val[0], None, val[2])
+        result.validate_stats = _both(result, [rec], 'samples', layout,
+                                      width, x, K)
         result.validate_seconds = (time.perf_counter() - start
                                    - result.seconds)
     return result
+
+
+def _choose(program, recordings, layout, w, k0):
+    """Choose lambda and the width on the held-out blocks."""
+    cache = {}
+
+    def problems(width):
+        if width not in cache:
+            cache[width] = tuple(stacked(recordings, part, layout, width, w,
+                                         k0)[0] for part in ('train',
+                                                             'held'))
+        return cache[width]
+
+    def sweep(width):
+        train, held = problems(width)
+        errors = []
+        for lam in LAMBDAS:
+            x = program.solve(train, lam, f'prior weight {lam:g}')
+            if x is not None:
+                errors.append((lam, _error(held, x)))
+        if not errors:
+            raise IdentificationError(f'{recordings[0].path}: the fit '
+                                      f'failed (the solver found no '
+                                      f'solution)')
+        best = min(e for _, e in errors)
+        lam = max(lam for lam, e in errors if e <= best * (1 + LAMBDA_SLACK))
+        return lam, errors
+    lam, lam_errors = sweep(0)
+    width_errors = []
+    for i in range(len(layout.widths)):
+        train, held = problems(i)
+        x = program.solve(train, lam, f'Coulomb width '
+                                      f'{layout.widths[i]:g}')
+        if x is not None:
+            width_errors.append((layout.widths[i], _error(held, x), i))
+    width = 0
+    if width_errors:
+        best = min(width_errors, key=lambda t: t[1])
+        default = [e for e in width_errors if e[2] == 0]
+        if not default or best[1] < default[0][1] * (1 - WIDTH_SLACK):
+            width = best[2]
+    if width != 0:
+        lam, lam_errors = sweep(width)
+    return lam, width, lam_errors, [(a, b) for a, b, _ in width_errors]
+
+
+def _both(result, recordings, part, layout, width, x, k_eff):
+    """Nominal and identified stats of ``part`` (N m, relative)."""
+    x0 = x.copy()
+    x0[:layout.p_theta] = result.theta0
+    return {'nominal': joint_stats(recordings, part, layout, width, x0,
+                                   k_eff, k_eff),
+            'identified': joint_stats(recordings, part, layout, width, x,
+                                      k_eff, k_eff)}
+
+
+def _report(result, recordings, layout, width, x, K, known, program):
+    """Fill the result's statistics, payload and notes."""
+    plain = [r for r in recordings if not r.loaded]
+    result.fit_stats = _both(result, plain, 'samples', layout, width, x, K)
+    if any(r.held is not None and r.held.rows.min() > 0 for r in plain):
+        held = _both(result, plain, 'held_samples', layout, width, x, K)
+        result.fit_stats['held_out_nominal'] = held['nominal']
+        result.fit_stats['held_out_identified'] = held['identified']
+    if known:
+        from ..core.regressor import link_inertials
+        m, c, Ic = link_inertials(x[layout.pay])
+        result.payload = {'mass': float(m), 'com': c, 'inertia': Ic}
+    if program.trouble:
+        result.notes.append(
+            f'{INACCURATE} for {", ".join(program.trouble[:3])}'
+            + (' ...' if len(program.trouble) > 3 else ''))
 
 
 def _clean(theta, fixed, n):

@@ -19,7 +19,10 @@ The arm's model (identified inertials and drive terms) predicts what the
 drives need without the payload; the rest of the measured effort is the
 payload's:
 
-    effort - tau_arm(q, qd, qdd) - tau_drives(qd, qdd) = Y_tip T pi_p
+    K effort - tau_arm(q, qd, qdd) - tau_drives(qd, qdd) = Y_tip T pi_p
+
+with K the URDF's torque constants when the efforts are motor currents
+(``core.drives``: ``torque_constant``; 1 for torques).
 
 ``Y_tip`` is the last link's ten columns of the torque regressor
 (``core.regressor``: parameters about the last link frame's origin, in its
@@ -29,9 +32,9 @@ X J X^T with X the 4x4 pose of the tip in the link frame, which is the
 model's ``tool``).  ``pi_p`` = (m, m c, I about the tip origin) in the tip
 frame.
 
-The samples come from the identification pipeline (``fit.prepared_windows``:
-resampled, zero-phase filtered, same filter on the effort), reduced to a
-10 x 10 R factor per joint.  Each joint is weighted by 1 / its residual RMS
+The samples come from the identification pipeline (``reduce``:
+resampled, zero-phase filtered, same filter on the effort), reduced to an
+11 x 11 R factor per joint.  Each joint is weighted by 1 / its residual RMS
 (unconstrained fit first), and the fit is a small semidefinite program:
 the payload's pseudo-inertia positive semi-definite (so m >= 0 and the
 inertia physical), with a tiny pull toward zero so that directions the
@@ -50,7 +53,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .fit import _decimation, IdentificationError, prepared_windows, Reduced
+from .reduce import IdentificationError, reduce_recording
 from ..core.drives import model_drives
 from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
                               regressor_batch)
@@ -58,11 +61,13 @@ from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
 MASS_TOL = 0.05           # relative standard error of the mass
 MASS_ABS = 0.02           # kg: below this the payload is "no payload"
 MASS_TOL_ABS = 0.05       # kg: a mass error this small is determined
-COM_TOL = 0.01            # m, standard error of each coordinate
+# m, bound of each coordinate: the 15 mm a payload's centre of mass is
+# asked for (the bound is a worst case: a 2 kg tool's z came out 1 mm
+# off on a 4 s recording, with a bound of 14 mm)
+COM_TOL = 0.015
 INERTIA_TOL = 0.3         # relative standard error
 INERTIA_ABS = 2e-3        # kg m^2
 PRIOR_WEIGHT = 1e-6       # pull toward zero, of the data's scale
-STATE_CHUNK = 4096
 INERTIA_KEYS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 INERTIA_NAMES = ('Ixx', 'Iyy', 'Izz', 'Ixy', 'Iyz', 'Ixz')
 
@@ -104,12 +109,46 @@ class PayloadEstimate:
     joint_names: list = field(default_factory=list)
 
     def parameters(self):
-        """Return the node's payload.* parameters as a JSON-ready dict."""
+        """
+        Return the node's payload.* parameters as a JSON-ready dict.
+
+        What the motion does not determine is ``None`` (JSON ``null``):
+        the mass, a centre-of-mass coordinate or an inertia term, and
+        ``'undetermined'`` maps each parameter holding one to the reason.
+        A parameter without ``None`` can be set on the node as it is.
+        """
+        d = self.determined
         I = self.inertia  # noqa: E741
-        return {'payload.mass': float(self.mass),
-                'payload.com': [float(x) for x in self.com],
-                'payload.inertia': [float(I[a, b]) for a, b in
-                                    INERTIA_KEYS]}
+        com = [float(x) if ok else None for x, ok in zip(self.com, d['com'])]
+        inertia = [float(I[a, b]) if ok else None
+                   for (a, b), ok in zip(INERTIA_KEYS, d['inertia'])]
+        out = {'payload.mass': float(self.mass) if d['mass'] else None,
+               'payload.com': com, 'payload.inertia': inertia}
+        why = {}
+        if not d['mass']:
+            why['payload.mass'] = (f'standard error {self.mass_std:.3g} kg')
+        if not d['present']:
+            reason = (f'no payload: the mass is below {MASS_ABS:g} kg or '
+                      f'twice its uncertainty')
+            why['payload.com'] = why['payload.inertia'] = reason
+        else:
+            bad = [a for a, ok in zip('xyz', d['com']) if not ok]
+            if bad:
+                why['payload.com'] = (f'{", ".join(bad)} not determined by '
+                                      f'this motion')
+            bad = [k for k, ok in zip(INERTIA_NAMES, d['inertia']) if not ok]
+            if bad:
+                why['payload.inertia'] = (
+                    f'{", ".join(bad)} not determined by this motion (rotate '
+                    f'the wrist about more axes)')
+        out['undetermined'] = why
+        return out
+
+    def settable(self):
+        """Return the parameters the node can take as they are (no None)."""
+        return {k: v for k, v in self.parameters().items()
+                if k.startswith('payload.') and v is not None
+                and not (isinstance(v, list) and None in v)}
 
     def undetermined_lines(self):
         """One line per quantity the recording does not determine."""
@@ -125,12 +164,13 @@ class PayloadEstimate:
         bad = [a for a, ok in zip('xyz', self.determined['com']) if not ok]
         if bad:
             out.append(f'centre of mass {", ".join(bad)} undetermined by '
-                       f'this motion (the JSON value is only a guess)')
+                       f'this motion (null in the JSON)')
         bad = [n for n, ok in zip(INERTIA_NAMES, self.determined['inertia'])
                if not ok]
         if bad:
             out.append(f'inertia {", ".join(bad)} undetermined by this '
-                       f'motion (rotate the wrist about more axes)')
+                       f'motion (rotate the wrist about more axes; null in '
+                       f'the JSON)')
         return out
 
     def summary_lines(self, tip):
@@ -200,36 +240,21 @@ def _clip_psd(pi):
 
 def estimate_payload(model, path, topic='/joint_states', cutoff=None):
     """Return a :class:`PayloadEstimate` from the bag at ``path``."""
+    from ..core import inverse_dynamics_batch
     n = model.n
     drives = model_drives(model)
     T = tip_to_link(model.tool)
-    red = Reduced(n, N_INERTIAL)
-    before = Reduced(n, 0)
-    samples = 0
-    t_first = None
-    duration = 0.0
-    from ..core import inverse_dynamics_batch
-    for piece in prepared_windows(path, model.joint_names, topic, cutoff):
-        step = _decimation(piece.rate, piece.cutoff)
-        idx = np.arange(0, len(piece), step)
-        if t_first is None:
-            t_first = piece.t[0]
-        duration = piece.t[-1] - t_first
-        samples += len(piece)
-        for a in range(0, len(idx), STATE_CHUNK):
-            sel = idx[a:a + STATE_CHUNK]
-            q, qd, qdd = piece.q[sel], piece.qd[sel], piece.qdd[sel]
-            tau = inverse_dynamics_batch(model, q, qd, qdd)
-            if drives is not None:
-                tau = tau + drives.torques(qd, qdd)
-            rest = piece.effort[sel] - tau
-            Y = regressor_batch(model, q, qd, qdd)[
-                :, :, N_INERTIAL * (n - 1):]
-            red.add(Y @ T, rest)
-            before.add(np.zeros((len(sel), n, 0)), rest)
-    if samples == 0:
-        raise IdentificationError(
-            f'{path}: too short: nothing is left after filtering')
+
+    def rows(q, qd, qdd, effort):
+        tau = inverse_dynamics_batch(model, q, qd, qdd)
+        if drives is not None:
+            tau = tau + drives.torques(qd, qdd)
+            # a motor current's torque: the torque constants of the URDF
+            effort = drives.effort_to_torque(effort)
+        Y = regressor_batch(model, q, qd, qdd)[:, :, N_INERTIAL * (n - 1):]
+        return Y @ T, effort - tau
+    red, _, info = reduce_recording(path, model.joint_names, rows,
+                                    N_INERTIAL, topic, cutoff, split=False)
     rows = np.maximum(red.rows, 1)
     A = red.stacked(np.ones(n))
     theta, *_ = np.linalg.lstsq(A[:, :-1], A[:, -1], rcond=1e-12)
@@ -271,9 +296,9 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None):
     inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 1e30)
     cov = (Vt.T * inv_s2) @ Vt / np.outer(Ds, Ds) * res_w ** 2
     est = _uncertainty(m, c, Ic, pi, cov)
-    est.samples = samples
-    est.duration = duration
-    est.residual_before = np.sqrt(before.sq_effort() / rows)
+    est.samples = info['samples']
+    est.duration = info['duration']
+    est.residual_before = np.sqrt(red.sq_effort() / rows)
     est.residual_after = np.sqrt(red.sq_residuals(pi) / rows)
     est.joint_names = list(model.joint_names)
     return est

@@ -108,8 +108,12 @@ def test_mass_and_com_from_a_recording(loaded):
     est = json.loads(out)
     with open(loaded['truth'], encoding='utf-8') as f:
         truth = json.load(f)
-    assert set(est) == {'payload.mass', 'payload.com', 'payload.inertia'}
+    assert set(est) == {'payload.mass', 'payload.com', 'payload.inertia',
+                        'undetermined'}
     assert len(est['payload.com']) == 3 and len(est['payload.inertia']) == 6
+    # this motion determines the mass and the centre of mass: numbers
+    assert est['payload.mass'] is not None
+    assert None not in est['payload.com']
     assert est['payload.mass'] == pytest.approx(truth['payload.mass'],
                                                 rel=0.03)
     err_com = np.linalg.norm(np.subtract(est['payload.com'],
@@ -117,11 +121,17 @@ def test_mass_and_com_from_a_recording(loaded):
     assert err_com <= 0.015, err_com
     # physically consistent: the inertia about the com is PSD with the
     # triangle inequality
-    Ixx, Iyy, Izz, Ixy, Iyz, Ixz = est['payload.inertia']
-    Ic = np.array([[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz, Izz]])
-    ev = np.linalg.eigvalsh(Ic)
-    assert ev.min() >= -1e-9
-    assert ev.sum() - 2 * ev.max() >= -1e-9
+    # the inertia: null where undetermined (a small body at the tip), and
+    # every number given physically consistent
+    inertia = est['payload.inertia']
+    if None in inertia:
+        assert 'payload.inertia' in est['undetermined']
+    else:
+        Ixx, Iyy, Izz, Ixy, Iyz, Ixz = inertia
+        Ic = np.array([[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz, Izz]])
+        ev = np.linalg.eigvalsh(Ic)
+        assert ev.min() >= -1e-9
+        assert ev.sum() - 2 * ev.max() >= -1e-9
 
 
 def test_summary_says_what_is_determined(loaded):
@@ -137,6 +147,10 @@ def test_no_payload_gives_mass_near_zero_never_negative(empty):
     est = json.loads(out)
     assert 0.0 <= est['payload.mass'] <= 0.03
     assert 'no payload' in err
+    # no payload: its centre of mass and inertia are null, with the reason
+    assert est['payload.com'] == [None] * 3
+    assert est['payload.inertia'] == [None] * 6
+    assert 'no payload' in est['undetermined']['payload.com']
     code, out, err = payload_cli(empty)
     assert code == 0 and 'no payload' in out
 
@@ -151,8 +165,13 @@ def test_poor_motion_reports_undetermined_quantities(tmp_path):
     assert 'rotate the wrist' in out
     # the mass still comes out (gravity on the shoulder joints)
     code, out, err = payload_cli(paths, '--json')
-    assert json.loads(out)['payload.mass'] == pytest.approx(1.5, rel=0.03)
+    est = json.loads(out)
+    assert est['payload.mass'] == pytest.approx(1.5, rel=0.03)
     assert 'undetermined' in err
+    # the inertia the motion cannot tell is null in the JSON, not a guess
+    # a user would paste into payload.inertia
+    assert est['payload.inertia'] == [None] * 6
+    assert 'rotate the wrist' in est['undetermined']['payload.inertia']
 
 
 def one_line(code, err, *words):

@@ -93,8 +93,12 @@ def test_synopsis_lists_the_parsers_options(command):
     # positional arguments: before the first option, by their --help names
     first = next((i for i, t in enumerate(tokens) if is_option(t)),
                  len(tokens))
-    positionals = [a.metavar or a.dest for a in actions
-                   if not a.option_strings]
+    positionals = []
+    for a in actions:
+        if not a.option_strings:      # X, or X [X ...] for several
+            name = a.metavar or a.dest
+            positionals += ([name, name, '...'] if a.nargs == '+'
+                            else [name])
     assert tokens[:first] == positionals, (command, tokens[:first])
     takes_value = {}
     for action in actions:

@@ -172,11 +172,11 @@ def test_replay_says_why_filtered_can_exceed_raw(loop, tmp_path):
     assert proc.returncode == 0, proc.stderr
     words = ' '.join(proc.stdout.split())
     assert 'rel % raw' in words
-    assert ('(the 10 Hz columns compare with the effort low-passed like the '
+    assert ('(the 10 Hz column compares with the effort low-passed like the '
             'state: free of noise, but smoothed where a joint reverses, '
             "while the model's friction still switches sharply there, so on "
-            'a joint with friction and little noise they can exceed the raw '
-            'ones; docs/identification.md)') in words, proc.stdout
+            'a joint with friction and little noise it can exceed the raw '
+            'one; docs/identification.md)') in words, proc.stdout
 
 
 def test_node_names_every_missing_joint(tmp_path):

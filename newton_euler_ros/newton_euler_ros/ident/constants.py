@@ -1,0 +1,147 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Torque constants from recordings whose efforts are motor currents.
+
+With e_j = tau_j / K_j, the residual in torque units, Y_j theta - K_j e_j,
+is linear in (theta, K), but least squares on it is biased: the effort's
+noise and stiction are multiplied by K_j, so smaller constants and a
+smaller theta fit "better" (errors in variables; on a UR-like recording
+the constants came out 40 % low that way, a known mass notwithstanding).
+In the effort's own unit, e_j - Y_j theta / K_j, the noise is where least
+squares expects it, and scaling theta and K together changes nothing:
+the scale is set by the nominal model's masses and gravity (the mean of
+the constants over the joints the nominal model explains, weighted by
+how well, is held at the nominal model's ratio ``effort.ratios``) or, with
+a recording of a known mass at the tip, by that mass.
+
+Variable projection: for given constants, the best theta is a linear
+least-squares problem (the reduced, weighted rows of ``problem.stacked``,
+joint j's weighted by 1 / (sigma_j K_j) with sigma_j its residual in the
+effort's unit, plus a faint prior as rows); what is left is a function
+of the n constants, minimised over log K by
+``scipy.optimize.least_squares``.  Only the joints whose effort follows
+the rigid-body torque (``effort.ratios``) are free; the constant of a
+joint whose effort is friction and noise (a UR's base or last wrist
+joint) is not told by the data, and gets the mean of the others.  The
+final fit (``fit``'s semidefinite program) then runs with the constants
+found.
+"""
+import numpy as np
+
+from .problem import stacked
+
+PRIOR_WEIGHT = 1e-6
+
+
+class _Projected:
+    """The effort-unit residual as a function of the constants."""
+
+    def __init__(self, recordings, layout, width, sigma_e, lam, D, theta0,
+                 mass):
+        self.args = (recordings, layout, width)
+        self.sigma_e = sigma_e
+        self.layout = layout
+        p = layout.p_theta
+        d = layout.size
+        sl = np.sqrt(lam)
+        self.prior = np.zeros((p, d))
+        self.prior[:, :p] = np.diag(sl * D)
+        self.prior_z = sl * D * theta0
+        self.mcol = layout.pay.start if mass is not None else None
+        self.mass = mass
+        self.rows = sum(int(r.part('all').rows.sum()) for r in recordings)
+
+    def solve(self, K):
+        """Return (x, residual vector) at constants K."""
+        recordings, layout, width = self.args
+        d = layout.size
+        w = 1.0 / (self.sigma_e * K)
+        Aug, _ = stacked(recordings, 'all', layout, width, w, K)
+        M = np.vstack([Aug[:d, :d], self.prior])
+        rhs = np.concatenate([Aug[:d, d], self.prior_z])
+        x = np.zeros(d)
+        cols = np.arange(d)
+        if self.mcol is not None:
+            x[self.mcol] = self.mass
+            rhs = rhs - M[:, self.mcol] * self.mass
+            cols = cols[cols != self.mcol]
+        x[cols], *_ = np.linalg.lstsq(M[:, cols], rhs, rcond=1e-12)
+        # the residual from the recordings' own factors: a smooth function
+        # of K (the stacked QR's rows may change sign from one K to the next)
+        parts = [self.prior @ x - self.prior_z]
+        for rec in recordings:
+            red = rec.part('all')
+            scale = 1.0 / np.sqrt(max(self.rows, 1))
+            for j in range(layout.n):
+                G, h = layout.coefficients(j, width, rec.loaded, K)
+                parts.append(w[j] * scale * (red.R[j] @ (G @ x + h)))
+        return x, np.concatenate(parts)
+
+
+def mass_excitation(recording, layout, sigma):
+    """
+    How much a known mass's torque changes, per joint, in residual units.
+
+    The torque of the mass as a point at the tip origin (its column in
+    the loaded recording), less what the joint's own drive terms could
+    explain (a constant is an offset), RMS over the recording, divided by
+    the joint's residual RMS ``sigma`` (N m).  Only a mass whose torque
+    changes fixes the scale: measured on UR-like recordings, about 5 on
+    the shoulder for excitations of the loaded arm, 0.01 or less on every
+    joint when only the base and the last wrist joint move.
+    """
+    red = recording.part('all')
+    out = np.zeros(layout.n)
+    for j in range(layout.n):
+        R = red.R[j]
+        a = R[:, layout.bag_columns(False)] * recording.mass
+        Q, _ = np.linalg.qr(R[:, layout.drive_columns(j)])
+        a = a - Q @ (Q.T @ a)
+        out[j] = np.linalg.norm(a) / np.sqrt(max(red.rows[j], 1)) / sigma[j]
+    return out
+
+
+def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
+                  free, pin=None, mass=None):
+    """
+    Return the torque constants (n,).
+
+    ``free`` marks the joints the data determines (the others get the
+    mean of theirs); ``pin`` (weights c, sum 1) holds sum c log(K / k0)
+    at 0 when there is no ``mass`` (kg at the tip of the loaded
+    recording).
+    """
+    from scipy.optimize import least_squares
+    # the prior toward the nominal model must not choose the scale (it would
+    # pull the constants toward the nominal masses, 10 % on a UR-like arm
+    # against its known mass): a weight just large enough to keep the
+    # directions the data does not see regular
+    proj = _Projected(recordings, layout, width, sigma_e,
+                      min(lam, PRIOR_WEIGHT), D, theta0, mass)
+    idx = np.flatnonzero(free)
+    c = None if pin is None else pin[idx] / pin[idx].sum()
+
+    def constants(u):
+        if c is not None:
+            u = u - c @ u
+        K = np.array(k0, dtype=np.float64)
+        K[idx] = k0[idx] * np.exp(u)
+        K[~free] = K[idx].mean()
+        return K
+    fit = least_squares(lambda u: proj.solve(constants(u))[1],
+                        np.zeros(len(idx)), method='trf', x_scale=1.0,
+                        diff_step=1e-4, xtol=1e-6, ftol=1e-9)
+    return constants(fit.x)

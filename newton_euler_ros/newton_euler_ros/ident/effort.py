@@ -1,0 +1,118 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+What a recording's efforts are: joint torques, or proportional to them.
+
+``JointState.effort`` is a joint torque for some drivers (Franka: the
+link-side torque; KUKA FRI: the measured torque) and a motor current for
+others (UR's ROS 2 driver by default, Dynamixel-based arms), the torque
+being K_j times it with an unknown constant per joint.  Fitting torques
+to currents as if they were torques gives a model scaled by 1/K: a
+plausible-looking URDF with every mass ten times too small.
+
+The nominal model tells them apart.  Per joint j, the least-squares ratio
+K_j of the nominal torque to the effort, e_j = tau_nom,j / K_j, both
+less what the joint's drive terms (viscous and Coulomb friction, offset,
+armature) explain, since a published URDF has no friction but the effort
+has: K_j is about 1 when the efforts are torques the nominal model
+roughly predicts, about the torque constant when they are currents.  A
+joint counts when the two agree in shape (squared correlation at least
+``MIN_EXPLAINED``: a joint whose nominal torque is small or wrong says
+nothing); the efforts are refused as torques when at least
+half of the joints that count are outside ``TORQUE_BAND``, and as
+anything proportional to torque when a joint that counts has a negative
+ratio (the driver's sign convention, or joints swapped).
+
+Everything is computed from the reduced recording (``reduce.Reduced``):
+inner products of columns are inner products of their images by R.
+"""
+import numpy as np
+
+from .reduce import IdentificationError
+
+TORQUE_BAND = (0.4, 2.5)
+MIN_EXPLAINED = 0.5
+
+
+def ratios(red, u, drive_columns):
+    """
+    Per joint: (K, explained) of the least-squares ratio.
+
+    ``red`` a ``reduce.Reduced`` whose last column is the effort; ``u``
+    the column coefficients giving the nominal torque (without the
+    effort); ``drive_columns(j)`` the indices of joint j's drive columns.
+    Both the nominal torque t and the effort e are taken less their
+    projection on the drive columns (t1, e1); the effort is regressed on
+    the torque, e1 = t1 / K (so noise and stiction in the effort do not
+    bias K), and ``explained`` is the squared correlation of t1 and e1.
+    """
+    n = red.n
+    K = np.zeros(n)
+    explained = np.zeros(n)
+    for j in range(n):
+        Rj = red.R[j]
+        if Rj.shape[0] == 0:
+            continue
+        Q, _ = np.linalg.qr(Rj[:, drive_columns(j)])
+        t = Rj[:, :-1] @ u
+        e = Rj[:, -1]
+        t = t - Q @ (Q.T @ t)
+        e = e - Q @ (Q.T @ e)
+        te, tt, ee = float(t @ e), float(t @ t), float(e @ e)
+        if not (tt > 0 and ee > 0 and te != 0):
+            continue
+        K[j] = tt / te
+        explained[j] = te * te / (tt * ee)
+    return K, explained
+
+
+def _cells(names, K, sel):
+    return ', '.join(f'{names[j]} {K[j]:.3g}' for j in np.flatnonzero(sel))
+
+
+def check(label, names, K, explained, mode, urdf=None):
+    """
+    Raise IdentificationError (one line) when the effort cannot be ``mode``.
+
+    ``mode``: 'torque' (efforts in N m), 'given' (efforts times the
+    URDF's torque constants, ``urdf`` names it) or 'current' (efforts
+    proportional to torque with unknown constants).
+    """
+    counts = explained >= MIN_EXPLAINED
+    negative = counts & (K < 0)
+    if negative.any():
+        raise IdentificationError(
+            f"{label}: the effort has the opposite sign of the model's "
+            f'torque on {_cells(names, K, negative)} (least-squares ratio '
+            f"model torque / effort): check the driver's sign convention "
+            f'and the joint names')
+    if mode == 'current' or counts.sum() == 0:
+        return
+    lo, hi = TORQUE_BAND
+    off = counts & ((K < lo) | (K > hi))
+    if off.sum() * 2 < counts.sum():
+        return
+    ratio = _cells(names, K, off)
+    if mode == 'given':
+        raise IdentificationError(
+            f'{label}: the efforts do not match the torque constants of '
+            f'{urdf}: model torque / (torque_constant x effort) is {ratio} '
+            f'(near 1 expected); fix or remove the torque_constant '
+            f'attributes')
+    raise IdentificationError(
+        f'{label}: the efforts are not joint torques in N m: model torque '
+        f'/ effort is {ratio} (least-squares ratio per joint, near 1 for '
+        f"torques); if the driver reports motor currents (UR's default), "
+        f'add --effort current')
