@@ -1,0 +1,354 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+inverse_dynamics_node on a whole robot, over DDS, against Pinocchio.
+
+The test plays robot_state_publisher with Baxter's published URDF
+(example-robot-data: two arms and a head, each gripper with a mimic
+finger) on a latched ``/robot_description``, and starts the node as a
+user would for a whole robot: ``base_link`` only, no ``tip_link``, the
+left arm's joints (shuffled) on ``~/torque_command`` for an effort
+controller.  Then, as the robot's drivers and sensors would:
+
+- full JointStates, every joint (the mimic fingers too) in shuffled
+  order: ``~/torques`` names all 17 independent joints and equals
+  Pinocchio's ``rnea`` on ``buildModelFromUrdf(path, mimic=True)``
+  (joints matched by name), ``~/torque_command`` those of ``joints`` in
+  its order;
+- the same state split across two publishers (an arm driver, a gripper
+  driver), the gripper's message alone publishing nothing;
+- the service's D, C and g of the whole tree against Pinocchio's;
+- a force-torque sensor at each wrist (two frame_ids) against
+  sum J_link^T F of Pinocchio's Jacobians, each sensor expiring alone;
+- a mimic finger off its leader: refused, counted, one log line naming
+  both joints and their values;
+- a trajectory of the left arm alone: its efforts with the other joints
+  held where they were last measured (that the hold counts where a joint
+  carries the arm, as a torso does, is in ``core/test_trajectory.py``);
+- a payload in the left gripper (``payload.link``): Pinocchio with the
+  same inertia added to the gripper's joint.
+"""
+import os
+import random
+import warnings
+
+import numpy as np
+import pytest
+
+pytest.importorskip('rclpy')
+
+from builtin_interfaces.msg import Duration  # noqa: E402, I100
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402
+from geometry_msgs.msg import WrenchStamped  # noqa: E402
+from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
+from newton_euler_ros.core import load_urdf  # noqa: E402
+from rcl_interfaces.srv import SetParametersAtomically  # noqa: E402
+from rclpy.parameter import Parameter  # noqa: E402
+from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
+                       ReliabilityPolicy)
+from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
+                         NodeProcess, Probe)
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import Float64MultiArray, String  # noqa: E402
+from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
+                                 JointTrajectoryPoint)
+
+pytestmark = pytest.mark.ros
+
+NODE = '/inverse_dynamics_node'
+BAXTER = 'baxter_description/urdf/baxter.urdf'
+LATCHED = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                     durability=DurabilityPolicy.TRANSIENT_LOCAL)
+LEFT_ARM = ['left_s0', 'left_s1', 'left_e0', 'left_e1', 'left_w0', 'left_w1',
+            'left_w2']
+# what an effort controller of the left arm commands, in its own order
+COMMANDED = ['left_w2', 'left_e1', 'left_s0', 'left_w0', 'left_s1',
+             'left_e0', 'left_w1']
+FINGERS = ['r_gripper_l_finger_joint', 'r_gripper_r_finger_joint',
+           'l_gripper_l_finger_joint', 'l_gripper_r_finger_joint']
+TIMEOUT = 0.5           # wrench.timeout
+
+
+@pytest.fixture(scope='module')
+def baxter():
+    from newton_euler_tools.peers import example_robot_urdf, PinocchioTree
+    path = example_robot_urdf(BAXTER)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_urdf(path)
+    with open(path, encoding='utf-8') as fh:
+        text = fh.read()
+    return model, PinocchioTree(path, model), text
+
+
+class Robot:
+    """The graph: description, the node, two drivers, two sensors."""
+
+    def __init__(self, tmp, text):
+        self.domain = domain_id(41)
+        self.probe = Probe(self.domain)
+        self.description = self.probe.node.create_publisher(
+            String, '/robot_description', LATCHED)
+        self.description.publish(String(data=text))
+        self.node = NodeProcess(id_node_cmd(
+            None, '-p', 'base_link:=base', '-p', 'limits.action:=publish',
+            '-p', f'joints:=[{", ".join(COMMANDED)}]',
+            '-p', f'wrench.timeout:={TIMEOUT}', '-p', 'log_throttle:=0.01'),
+            self.domain, os.path.join(tmp, 'node.log'))
+        self.torques = self.probe.collect(JointState, f'{NODE}/torques')
+        self.commands = self.probe.collect(Float64MultiArray,
+                                           f'{NODE}/torque_command')
+        self.diag = self.probe.collect(DiagnosticArray, '/diagnostics')
+        # the arm driver and the gripper driver: two publishers
+        self.arm = self.probe.publisher(JointState, '/joint_states')
+        self.gripper = self.probe.publisher(JointState, '/joint_states')
+        self.sensors = self.probe.publisher(WrenchStamped, '/wrench')
+        assert self.probe.spin_until(
+            lambda: self.arm.get_subscription_count() > 0
+            and self.sensors.get_subscription_count() > 0
+            and 'baxter (robot_description' in self.node.log(), 90.0), \
+            self.node.log()
+        self.seq = 0
+
+    def stamp(self):
+        self.seq += 1
+        return self.probe.keyed_stamp(self.seq)
+
+    def send(self, publisher, names, q, qd, wait=5.0):
+        stamp = self.stamp()
+        publisher.publish(joint_state(names, q, qd, stamp))
+        return self.probe.answer(self.torques, stamp, wait)
+
+    def command_for(self, stamp_answer):
+        """Return the torque_command published with a ~/torques message."""
+        index = next(i for i, t in enumerate(self.torques)
+                     if t is stamp_answer)
+        self.probe.spin_until(lambda: len(self.commands) > index, 5.0)
+        return self.commands[index]
+
+    def close(self):
+        code = self.node.stop()
+        self.probe.close()
+        return code
+
+
+@pytest.fixture(scope='module')
+def robot(tmp_path_factory, baxter):
+    r = Robot(str(tmp_path_factory.mktemp('whole_robot')), baxter[2])
+    yield r
+    assert r.close() == 0, r.node.log()
+
+
+def moving_state(model, q, qd):
+    """Every moving joint's position and velocity, followers from leaders."""
+    x, v = {}, {}
+    for b, name in enumerate(model.moving_joints):
+        mimic = model.mimic[b]
+        lead, mult, off = ((b, 1.0, 0.0) if mimic is None else mimic)
+        k = model.independent.index(lead)
+        x[name], v[name] = mult * q[k] + off, mult * qd[k]
+    return x, v
+
+
+def by_name(message, names):
+    where = {name: i for i, name in enumerate(message.name)}
+    return np.array([message.effort[where[name]] for name in names])
+
+
+def state(model, seed):
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-1.0, 1.0, model.n)
+    qd = rng.uniform(-0.8, 0.8, model.n)
+    for k, name in enumerate(model.joint_names):
+        if 'finger' in name:        # the fingers' range: 0 to 2 cm
+            q[k], qd[k] = rng.uniform(0.0, 0.02), rng.uniform(-0.01, 0.01)
+    return q, qd
+
+
+def test_full_joint_states_in_any_order_against_pinocchio(robot, baxter):
+    model, peer, _ = baxter
+    for seed in range(4):
+        q, qd = state(model, seed)
+        x, v = moving_state(model, q, qd)
+        names = list(model.moving_joints)       # the fingers' mimics too
+        random.Random(seed).shuffle(names)
+        out = robot.send(robot.arm, names, [x[j] for j in names],
+                         [v[j] for j in names])
+        assert out is not None, robot.node.log()
+        # every independent joint, commanded ones first
+        assert list(out.name[:7]) == COMMANDED
+        assert sorted(out.name) == sorted(model.joint_names)
+        expected = peer.terms(q, qd, np.zeros(model.n))['tau']
+        got = by_name(out, model.joint_names)
+        assert np.abs(got - expected).max() <= 1e-9 * max(
+            1.0, np.abs(expected).max()), (got, expected)
+        command = robot.command_for(out)
+        assert list(command.data) == list(out.effort[:7])
+
+
+def test_joint_states_split_across_two_drivers(robot, baxter):
+    model, peer, _ = baxter
+    q, qd = state(model, 11)
+    x, v = moving_state(model, q, qd)
+    body = [j for j in model.moving_joints if j not in FINGERS]
+    held = robot.probe.next_counters(robot.diag)['held']
+    # the gripper driver alone: held for the arm's message, no torques
+    assert robot.send(robot.gripper, FINGERS, [x[j] for j in FINGERS],
+                      [v[j] for j in FINGERS], wait=0.05) is None
+    out = robot.send(robot.arm, body[::-1], [x[j] for j in body[::-1]],
+                     [v[j] for j in body[::-1]])
+    assert out is not None, robot.node.log()
+    expected = peer.terms(q, qd, np.zeros(model.n))['tau']
+    np.testing.assert_allclose(by_name(out, model.joint_names), expected,
+                               rtol=0, atol=1e-9)
+    assert robot.probe.next_counters(robot.diag)['held'] == held + 1
+    # fingers last heard of more than joint_states.hold (0.5 s) ago
+    robot.probe.spin_for(0.6)
+    assert robot.send(robot.arm, body, [x[j] for j in body],
+                      [v[j] for j in body], wait=1.0) is None
+    assert 'older than joint_states.hold (0.5 s)' in robot.node.log()
+    # the fingers moved (q = 0 for them would give other torques)
+    zero = q.copy()
+    zero[[model.joint_names.index(j) for j in FINGERS[::2]]] = 0.0
+    assert np.abs(peer.terms(zero, qd, 0 * qd)['tau'] - expected).max() \
+        > 1e-6
+
+
+def test_service_d_c_g_of_the_whole_tree(robot, baxter):
+    model, peer, _ = baxter
+    q, qd = state(model, 21)
+    qdd = np.random.default_rng(21).uniform(-1, 1, model.n)
+    names = list(model.joint_names)[::-1]
+    order = [model.joint_names.index(j) for j in names]
+    reply = robot.probe.call(ComputeDynamics, f'{NODE}/compute_dynamics',
+                             ComputeDynamics.Request(
+                                 name=names, position=q[order].tolist(),
+                                 velocity=qd[order].tolist(),
+                                 acceleration=qdd[order].tolist()))
+    assert reply.success, reply.message
+    n = model.n
+    assert list(reply.name[:7]) == COMMANDED and len(reply.name) == n
+    k = [model.joint_names.index(j) for j in reply.name]    # ours -> reply
+    theirs = peer.terms(q, qd, qdd)
+    D = np.reshape(reply.mass_matrix, (n, n))
+    C = np.reshape(reply.coriolis_matrix, (n, n))
+    for got, want in ((D, theirs['D'][np.ix_(k, k)]),
+                      (C, theirs['C'][np.ix_(k, k)]),
+                      (np.array(reply.gravity), theirs['g'][k]),
+                      (np.array(reply.torque), theirs['tau'][k])):
+        assert np.abs(got - want).max() <= 1e-9 * max(1.0,
+                                                      np.abs(want).max())
+    # the two arms do not couple: D is zero between them
+    left = [reply.name.index(j) for j in LEFT_ARM]
+    right = [reply.name.index(j.replace('left', 'right')) for j in LEFT_ARM]
+    assert not D[np.ix_(left, right)].any()
+
+
+def test_a_mimic_finger_off_its_leader_is_refused(robot, baxter):
+    model, _, _ = baxter
+    q, qd = state(model, 31)
+    x, v = moving_state(model, q, qd)
+    names = list(model.moving_joints)
+    x['l_gripper_r_finger_joint'] = -x['l_gripper_l_finger_joint'] + 0.01
+    before = robot.probe.next_counters(robot.diag)['mimic_mismatch']
+    assert robot.send(robot.arm, names, [x[j] for j in names],
+                      [v[j] for j in names], wait=1.0) is None
+    assert robot.probe.next_counters(robot.diag)['mimic_mismatch'] == \
+        before + 1
+    line = next(x for x in robot.node.log().splitlines()
+                if 'mimic_mismatch' in x)
+    assert "mimic joint 'l_gripper_r_finger_joint' is at" in line
+    assert "its leader 'l_gripper_l_finger_joint' at" in line
+    # within the tolerance it is taken
+    x['l_gripper_r_finger_joint'] = -x['l_gripper_l_finger_joint'] + 0.001
+    assert robot.send(robot.arm, names, [x[j] for j in names],
+                      [v[j] for j in names]) is not None
+
+
+def test_a_trajectory_of_one_arm_holds_the_others(robot, baxter):
+    model, peer, _ = baxter
+    q, qd = state(model, 41)
+    x, v = moving_state(model, q, qd)
+    names = list(model.moving_joints)
+    assert robot.send(robot.arm, names, [x[j] for j in names],
+                      [v[j] for j in names]) is not None
+    traj_in = robot.probe.publisher(JointTrajectory, f'{NODE}/trajectory_in')
+    traj_out = robot.probe.collect(JointTrajectory, f'{NODE}/trajectory_out')
+    assert robot.probe.spin_until(
+        lambda: traj_in.get_subscription_count() > 0, 10.0)
+    rng = np.random.default_rng(41)
+    arm = [model.joint_names.index(j) for j in LEFT_ARM]
+    points = [rng.uniform(-1, 1, (3, 7)) for _ in range(3)]
+    msg = JointTrajectory(joint_names=LEFT_ARM)
+    for k, (p, pd, pdd) in enumerate(points):
+        msg.points.append(JointTrajectoryPoint(
+            positions=p.tolist(), velocities=pd.tolist(),
+            accelerations=pdd.tolist(), time_from_start=Duration(sec=k)))
+    traj_in.publish(msg)
+    assert robot.probe.spin_until(lambda: len(traj_out) > 0, 10.0), \
+        robot.node.log()
+    assert list(traj_out[0].joint_names) == LEFT_ARM
+    for (p, pd, pdd), point in zip(points, traj_out[0].points):
+        full = [q.copy(), np.zeros(model.n), np.zeros(model.n)]
+        for X, part in zip(full, (p, pd, pdd)):
+            X[arm] = part
+        expected = peer.terms(*full)['tau'][arm]
+        np.testing.assert_allclose(point.effort, expected, rtol=0,
+                                   atol=1e-9)
+
+
+def test_a_payload_in_one_gripper(robot, baxter):
+    model, peer, _ = baxter
+    pin = peer.pin
+    mass, com = 1.5, [0.01, -0.02, 0.05]
+    inertia = [0.004, 0.005, 0.003, 0.0002, -0.0001, 0.0003]
+    params = [Parameter(name, value=value).to_parameter_msg()
+              for name, value in (('payload.mass', mass),
+                                  ('payload.com', com),
+                                  ('payload.inertia', inertia),
+                                  ('payload.link', 'left_gripper'))]
+    result = robot.probe.call(
+        SetParametersAtomically, f'{NODE}/set_parameters_atomically',
+        SetParametersAtomically.Request(parameters=params)).result
+    assert result.successful, result.reason
+    # Pinocchio: the same rigid body added to the joint carrying the
+    # gripper frame
+    from newton_euler_tools.peers import example_robot_urdf
+    loaded = pin.buildModelFromUrdf(example_robot_urdf(BAXTER), mimic=True)
+    frame = loaded.frames[loaded.getFrameId('left_gripper')]
+    Ixx, Iyy, Izz, Ixy, Iyz, Ixz = inertia
+    body = pin.Inertia(mass, np.array(com), np.array(
+        [[Ixx, Ixy, Ixz], [Ixy, Iyy, Iyz], [Ixz, Iyz, Izz]]))
+    loaded.inertias[frame.parentJoint] += frame.placement.act(body)
+    data = loaded.createData()
+    q, qd = state(model, 51)
+    x, v = moving_state(model, q, qd)
+    names = list(model.moving_joints)
+    out = robot.send(robot.arm, names, [x[j] for j in names],
+                     [v[j] for j in names])
+    assert out is not None, robot.node.log()
+    expected = pin.rnea(loaded, data, peer.config(q), peer.vector(qd),
+                        np.zeros(loaded.nv))[peer.iv]
+    np.testing.assert_allclose(by_name(out, model.joint_names), expected,
+                               rtol=0, atol=1e-9)
+    without = peer.terms(q, qd, 0 * qd)['tau']
+    changed = {model.joint_names[k] for k in
+               np.flatnonzero(np.abs(expected - without) > 1e-9)}
+    assert changed and changed <= set(LEFT_ARM)     # the left arm's only
+    params = [Parameter('payload.mass', value=0.0).to_parameter_msg(),
+              Parameter('payload.inertia', value=[0.0] * 6).to_parameter_msg()]
+    assert robot.probe.call(
+        SetParametersAtomically, f'{NODE}/set_parameters_atomically',
+        SetParametersAtomically.Request(parameters=params)).result.successful
