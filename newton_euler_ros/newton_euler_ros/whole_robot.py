@@ -331,7 +331,9 @@ class LinkWrenches:
                 + (f'stamped {stamp - now:.3f} s in the future' if ahead
                    else f'{now - stamp:.3f} s old')
                 + f' (timeout {self.timeout} s)')
-        for other, (o_at, o_axes, _, _) in self.held.items():
+        for other, (o_at, o_axes, _, o_stamp) in self.held.items():
+            if self.timeout and now - o_stamp > self.timeout:
+                continue            # expired: no longer applies
             if other != frame_id and o_at == at and o_axes != axes:
                 raise InputRejected(
                     'malformed', f'wrench in {clip(frame_id, 80)!r} acts at '

@@ -30,8 +30,9 @@ controller.  Then, as the robot's drivers and sensors would:
 - the same state split across two publishers (an arm driver, a gripper
   driver), the gripper's message alone publishing nothing;
 - the service's D, C and g of the whole tree against Pinocchio's;
-- a force-torque sensor at each wrist (two frame_ids) against
-  sum J_link^T F of Pinocchio's Jacobians, each sensor expiring alone;
+- a force-torque sensor at each wrist (two frame_ids, the sensors'
+  sign) against sum J_link^T F of Pinocchio's Jacobians in link axes,
+  each sensor expiring alone, an unknown frame counted and dropped;
 - a mimic finger off its leader: refused, counted, one log line naming
   both joints and their values;
 - a trajectory of the left arm alone: its efforts with the other joints
@@ -59,7 +60,7 @@ from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
 from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe)
+                         NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray, String  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
@@ -78,7 +79,8 @@ COMMANDED = ['left_w2', 'left_e1', 'left_s0', 'left_w0', 'left_s1',
              'left_e0', 'left_w1']
 FINGERS = ['r_gripper_l_finger_joint', 'r_gripper_r_finger_joint',
            'l_gripper_l_finger_joint', 'l_gripper_r_finger_joint']
-TIMEOUT = 0.5           # wrench.timeout
+TIMEOUT = 2.0           # wrench.timeout, s
+WRISTS = ('left_gripper', 'right_gripper')
 
 
 @pytest.fixture(scope='module')
@@ -105,7 +107,9 @@ class Robot:
         self.node = NodeProcess(id_node_cmd(
             None, '-p', 'base_link:=base', '-p', 'limits.action:=publish',
             '-p', f'joints:=[{", ".join(COMMANDED)}]',
-            '-p', f'wrench.timeout:={TIMEOUT}', '-p', 'log_throttle:=0.01'),
+            '-p', f'wrench.timeout:={TIMEOUT}',
+            '-p', 'wrench.convention:=applied_to_robot',
+            '-p', 'log_throttle:=0.01'),
             self.domain, os.path.join(tmp, 'node.log'))
         self.torques = self.probe.collect(JointState, f'{NODE}/torques')
         self.commands = self.probe.collect(Float64MultiArray,
@@ -275,6 +279,55 @@ def test_a_mimic_finger_off_its_leader_is_refused(robot, baxter):
     x['l_gripper_r_finger_joint'] = -x['l_gripper_l_finger_joint'] + 0.001
     assert robot.send(robot.arm, names, [x[j] for j in names],
                       [v[j] for j in names]) is not None
+
+
+def test_a_sensor_at_each_wrist(robot, baxter):
+    model, peer, _ = baxter
+    q, qd = state(model, 61)
+    x, v = moving_state(model, q, qd)
+    names = list(model.moving_joints)
+    F = {'left_gripper': np.array([5.0, -12.0, 20.0, 0.5, -0.3, 0.8]),
+         'right_gripper': np.array([-8.0, 3.0, -15.0, -0.2, 0.9, 0.1])}
+    theirs = peer.terms(q, qd, np.zeros(model.n), WRISTS)
+    # what each sensor adds: the environment pushes on the gripper, the
+    # arm holds it (applied_to_robot: -J^T F)
+    adds = {link: -theirs[f'J {link} link'].T @ F[link] for link in WRISTS}
+
+    def torques():
+        out = robot.send(robot.arm, names, [x[j] for j in names],
+                         [v[j] for j in names])
+        assert out is not None, robot.node.log()
+        return by_name(out, model.joint_names)
+
+    def publish(link):
+        now = robot.probe.node.get_clock().now().to_msg()
+        robot.sensors.publish(wrench(link, F[link], now))
+
+    publish('left_gripper')
+    robot.probe.spin_for(1.2)
+    publish('right_gripper')
+    robot.probe.spin_for(0.1)
+    np.testing.assert_allclose(
+        torques(), theirs['tau'] + adds['left_gripper']
+        + adds['right_gripper'], rtol=0, atol=1e-9)
+    assert np.abs(adds['left_gripper']).max() > 1.0
+    # the left sensor's wrench is older than wrench.timeout, the right
+    # one's not: it applies alone
+    robot.probe.spin_for(1.2)
+    np.testing.assert_allclose(torques(), theirs['tau']
+                               + adds['right_gripper'], rtol=0, atol=1e-9)
+    assert 'the last wrench (left_gripper) is older than' in \
+        robot.node.log()
+    # a frame that is no link of Baxter; base axes (wrench.base_frames)
+    # with no link to act at (no wrench.link, several tips)
+    unknown = robot.probe.next_counters(robot.diag)['unknown_frame']
+    for frame in ('left_ft_sensor', 'base_link'):
+        now = robot.probe.node.get_clock().now().to_msg()
+        robot.sensors.publish(wrench(frame, F['left_gripper'], now))
+    assert robot.probe.spin_until(
+        lambda: robot.probe.next_counters(robot.diag)['unknown_frame']
+        == unknown + 2, 5.0)
+    robot.probe.spin_for(TIMEOUT)       # the right one expires too
 
 
 def test_a_trajectory_of_one_arm_holds_the_others(robot, baxter):
