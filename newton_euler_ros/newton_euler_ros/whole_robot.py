@@ -118,6 +118,8 @@ class JointStateMerger:
         self.qd = np.zeros(n)
         #: latest effort of each joint; NaN where its message had none
         self.effort = np.full(n, np.nan)
+        #: whether each joint's latest message had its velocity
+        self.rated = np.zeros(n, dtype=bool)
         #: node-clock time each joint was last received (-inf: never)
         self.seen = np.full(n, -np.inf)
         self._cache = {}
@@ -179,6 +181,7 @@ class JointStateMerger:
         into = where.into
         self.q[into] = q[where.take]
         self.qd[into] = 0.0 if qd is None else qd[where.take]
+        self.rated[into] = qd is not None
         if eff is None:
             self.effort[into] = np.nan
         else:       # a non-finite effort is no effort
@@ -198,6 +201,10 @@ class JointStateMerger:
         if missing.any():
             return None, [self.names[k] for k in np.flatnonzero(missing)]
         return self.effort.copy(), []
+
+    def unrated(self):
+        """Return the joints whose latest message had no velocity."""
+        return [self.names[k] for k in np.flatnonzero(~self.rated)]
 
     def _check_mimic(self, where, q):
         x = q[where.mimic_take]

@@ -39,7 +39,11 @@ controller.  Then, as the robot's drivers and sensors would:
   held where they were last measured (that the hold counts where a joint
   carries the arm, as a torso does, is in ``core/test_trajectory.py``);
 - a payload in the left gripper (``payload.link``): Pinocchio with the
-  same inertia added to the gripper's joint.
+  same inertia added to the gripper's joint;
+- the momentum observer on efforts of a robot at rest pushed at its left
+  gripper: the external torque on every joint is J^T F, and of the
+  wrenches of ``observer.end_effectors`` the left gripper's is F, the
+  right one's zero.
 """
 import os
 import random
@@ -109,6 +113,8 @@ class Robot:
             '-p', f'joints:=[{", ".join(COMMANDED)}]',
             '-p', f'wrench.timeout:={TIMEOUT}',
             '-p', 'wrench.convention:=applied_to_robot',
+            '-p', 'observer.enabled:=true', '-p', 'observer.damping:=0.0',
+            '-p', f'observer.end_effectors:=[{", ".join(WRISTS)}]',
             '-p', 'log_throttle:=0.01'),
             self.domain, os.path.join(tmp, 'node.log'))
         self.torques = self.probe.collect(JointState, f'{NODE}/torques')
@@ -405,3 +411,39 @@ def test_a_payload_in_one_gripper(robot, baxter):
     assert robot.probe.call(
         SetParametersAtomically, f'{NODE}/set_parameters_atomically',
         SetParametersAtomically.Request(parameters=params)).result.successful
+
+
+def test_the_observer_reports_each_end_effector(robot, baxter):
+    model, peer, _ = baxter
+    external = robot.probe.collect(JointState, f'{NODE}/external_torque')
+    wrenches = robot.probe.collect(WrenchStamped, f'{NODE}/external_wrench')
+    q, _ = state(model, 71)
+    rest = np.zeros(model.n)
+    F = np.array([4.0, -6.0, 15.0, 0.4, 0.7, -0.3])    # on the gripper
+    theirs = peer.terms(q, rest, rest, WRISTS)
+    tau_ext = theirs['J left_gripper link'].T @ F
+    effort = dict(zip(model.joint_names, theirs['g'] - tau_ext))
+    x, v = moving_state(model, q, rest)
+    names = list(model.moving_joints)
+    for _ in range(40):         # 100 Hz, the observer's time constant 20 ms
+        stamp = robot.stamp()
+        msg = joint_state(names, [x[j] for j in names], [v[j] for j in names],
+                          stamp)
+        msg.effort = [effort.get(j, 0.0) for j in names]
+        robot.arm.publish(msg)
+        robot.probe.spin_for(0.01)
+    assert robot.probe.spin_until(
+        lambda: any(m.header.stamp == stamp for m in external), 5.0), \
+        robot.node.log()
+    last = next(m for m in external if m.header.stamp == stamp)
+    assert list(last.name) == list(model.joint_names)
+    np.testing.assert_allclose(last.effort, tau_ext, rtol=0, atol=1e-6)
+    robot.probe.spin_for(0.2)
+    got = {m.header.frame_id: m.wrench for m in wrenches
+           if m.header.stamp == stamp}
+    assert set(got) == set(WRISTS)
+    for link, expected in (('left_gripper', F), ('right_gripper', 0 * F)):
+        w = got[link]
+        values = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y,
+                  w.torque.z]
+        np.testing.assert_allclose(values, expected, rtol=0, atol=1e-6)
