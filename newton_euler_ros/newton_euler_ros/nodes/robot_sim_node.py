@@ -50,7 +50,8 @@ Subscribes
     (geometry_msgs/WrenchStamped, when the scene's wrench comes from the
     topic)
 Publishes
-    joint_states (sensor_msgs/JointState, effort = applied torque),
+    joint_states (sensor_msgs/JointState, effort = applied torque; a
+    tree's mimic joints after the others, following their leaders),
     wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),
     ~/start (std_msgs/Header, transient local)
 """
@@ -181,6 +182,16 @@ class RobotSimNode(SharedGraphNode):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self._state = JointState()
         self._state.name = list(scene.model.joint_names)
+        # a tree's mimic joints are published too, as a driver does:
+        # multiplier x leader + offset, no effort of their own
+        model = scene.model
+        follow = [(name, model.independent.index(m[0]), m[1], m[2])
+                  for name, m in zip(model.moving_joints, model.mimic or ())
+                  if m is not None]
+        self._state.name += [f[0] for f in follow]
+        self._lead = np.array([f[1] for f in follow], dtype=np.intp)
+        self._mult = np.array([f[2] for f in follow])
+        self._offset = np.array([f[3] for f in follow])
         self._wrench = WrenchStamped()
         if scene.wrench is not None:
             self._wrench.header.frame_id = FRAME_IDS[scene.wrench.frame]
@@ -283,9 +294,18 @@ class RobotSimNode(SharedGraphNode):
         self._publish_wrench(stamp)     # first: the torques need it
         msg = self._state
         msg.header.stamp = stamp
-        msg.position = self.q.tolist()
-        msg.velocity = self.qd.tolist()
-        msg.effort = self.applied.tolist()
+        if self._lead.size:
+            lead = self._lead
+            msg.position = np.concatenate([
+                self.q, self._mult * self.q[lead] + self._offset]).tolist()
+            msg.velocity = np.concatenate([
+                self.qd, self._mult * self.qd[lead]]).tolist()
+            msg.effort = np.concatenate([
+                self.applied, np.zeros(lead.size)]).tolist()
+        else:
+            msg.position = self.q.tolist()
+            msg.velocity = self.qd.tolist()
+            msg.effort = self.applied.tolist()
         self.state_pub.publish(msg)
 
     def _guarded(self, tau):

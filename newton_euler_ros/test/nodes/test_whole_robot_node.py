@@ -447,3 +447,56 @@ def test_the_observer_reports_each_end_effector(robot, baxter):
         values = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y,
                   w.torque.z]
         np.testing.assert_allclose(values, expected, rtol=0, atol=1e-6)
+
+
+def test_the_simulated_tree_held_by_the_node(baxter, tmp_path):
+    """robot_sim_node plays Baxter; the node's torques hold it still."""
+    import sys
+    model, _, _ = baxter
+    from newton_euler_tools.peers import example_robot_urdf
+    path = example_robot_urdf(BAXTER)
+    q0 = state(model, 81)[0]
+    scene = tmp_path / 'baxter.yaml'
+    scene.write_text(
+        f'name: baxter_hold\nrobot: {path}\n'
+        f'effects: {{gravity: true, velocity_products: true}}\n'
+        f'initial: {{q: {q0.tolist()}}}\n'
+        f'integrator: {{method: rk4, step: 1.0e-3, duration: 600.0, '
+        f'rate: 200.0}}\n')
+    domain = domain_id(43)
+    bindir = os.path.dirname(sys.executable)
+    sim = NodeProcess([os.path.join(bindir, 'robot_sim_node'), '--ros-args',
+                       '-p', f'scene:={scene}'], domain,
+                      str(tmp_path / 'sim.log'))
+    node = NodeProcess(id_node_cmd(
+        None, '-p', f'robot_file:={path}', '-p', 'base_link:=base',
+        '-p', 'limits.action:=publish',
+        '-r', '~/torque_command:=/robot_sim_node/commands'), domain,
+        str(tmp_path / 'node.log'))
+    probe = Probe(domain)
+    try:
+        heard = probe.collect(JointState, '/joint_states')
+
+        def states():       # the simulator's (a stray graph may share it)
+            return [m for m in heard if m.name[:1] == ['head_pan']]
+        assert probe.spin_until(lambda: len(states()) > 300, 90.0), \
+            sim.log() + node.log()
+        last = states()[-1]
+        assert list(last.name) == list(model.joint_names) + [
+            'r_gripper_r_finger_joint', 'l_gripper_r_finger_joint']
+        x = dict(zip(last.name, last.position))
+        for side in 'rl':
+            assert x[f'{side}_gripper_r_finger_joint'] == \
+                -x[f'{side}_gripper_l_finger_joint']
+        # 1.5 s of simulated time later, still where it started (a
+        # shoulder held by nothing drops by a radian in that time)
+        drift = np.abs(np.array(last.position[:model.n]) - q0).max()
+        assert drift < 1e-3, (drift, node.log())
+        assert 'mimic_mismatch' not in node.log()
+    finally:
+        probe.close()
+        assert node.stop() == 0, node.log()
+        assert sim.stop() == 0, sim.log()
+    # the simulator ran on the node's commands (it holds t = 0 without)
+    received = int(sim.log().split('commands received: ')[1].split()[0])
+    assert received > 300, sim.log()
