@@ -257,7 +257,8 @@ class LinkWrenches:
     sensor's own frame).  A frame_id of ``base_frames`` is in base axes,
     one of ``end_effector_frames`` in the axes of the link it acts at;
     both act at ``link``, or the end effector when ``link`` is empty (a
-    tree with several tips has none: they are then unknown frames).
+    tree with several tips has none: they are then unknown frames, even
+    one that is a link: the lists come first).
     Sensors are told apart by frame_id; each one's last wrench applies
     until it is older than ``timeout`` (0: forever).
 
@@ -302,18 +303,22 @@ class LinkWrenches:
 
     def target(self, frame_id):
         """Return (frame the wrench acts at, axes) of a frame_id."""
-        if self.at is not None and frame_id in self.base_frames:
-            return self.at, 'base'
-        if self.at is not None and frame_id in self.end_effector_frames:
-            return self.at, 'link'
+        listed = (frame_id in self.base_frames
+                  or frame_id in self.end_effector_frames)
+        if listed and self.at is not None:
+            return self.at, ('base' if frame_id in self.base_frames
+                             else 'link')
+        if listed:
+            raise InputRejected(
+                'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} '
+                f'of wrench.base_frames or end_effector_frames needs '
+                f'wrench.link to act at: the robot has several tips')
         if frame_id in self.links:
             return frame_id, 'link'
         raise InputRejected(
             'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} is '
-            f'not a link of the robot'
-            + ('' if self.at is not None else
-               ' (a frame of wrench.base_frames or end_effector_frames '
-               'needs wrench.link: the robot has several tips)'))
+            f'not a link of the robot nor one of wrench.base_frames, '
+            f'end_effector_frames')
 
     def update(self, frame_id, values, stamp, now):
         """Accept a sensor's wrench [fx, fy, fz, tx, ty, tz] stamped ``stamp``."""

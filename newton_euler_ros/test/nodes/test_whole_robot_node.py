@@ -18,9 +18,9 @@ inverse_dynamics_node on a whole robot, over DDS, against Pinocchio.
 The test plays robot_state_publisher with Baxter's published URDF
 (example-robot-data: two arms and a head, each gripper with a mimic
 finger) on a latched ``/robot_description``, and starts the node as a
-user would for a whole robot: ``base_link`` only, no ``tip_link``, the
-left arm's joints (shuffled) on ``~/torque_command`` for an effort
-controller.  Then, as the robot's drivers and sensors would:
+user would for a whole robot: ``config/params/baxter.yaml``, ``base_link``
+only, no ``tip_link``, the left arm's joints (shuffled) on
+``~/torque_command`` for an effort controller.  Then, as the robot's drivers and sensors would:
 
 - full JointStates, every joint (the mimic fingers too) in shuffled
   order: ``~/torques`` names all 17 independent joints and equals
@@ -108,8 +108,10 @@ class Robot:
         self.description = self.probe.node.create_publisher(
             String, '/robot_description', LATCHED)
         self.description.publish(String(data=text))
+        # the bundled parameter file for Baxter, base_link only (no tip)
         self.node = NodeProcess(id_node_cmd(
-            None, '-p', 'base_link:=base', '-p', 'limits.action:=publish',
+            'baxter.yaml', '-p', 'base_link:=base',
+            '-p', 'limits.action:=publish',
             '-p', f'joints:=[{", ".join(COMMANDED)}]',
             '-p', f'wrench.timeout:={TIMEOUT}',
             '-p', 'wrench.convention:=applied_to_robot',
