@@ -80,6 +80,8 @@ from ..safety import effort_bounds, TorqueGuard
 from ..sim.scene import load_scene
 from ..sim.simulate import integrator_step, SceneDynamics
 
+PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
+
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
             'end_effector': 'end_effector', 'ee_link': 'end_effector'}
@@ -121,8 +123,7 @@ class RobotSimNode(SharedGraphNode):
         except NewtonEulerError as exc:
             raise ConfigurationError(f'scene: {exc}') from None
         scene = self.scene
-        self.payload = (p['payload.mass'], p['payload.com'],
-                        p['payload.inertia'])
+        self.payload = tuple(p[k] for k in PAYLOAD)
         try:
             self.dyn = self._plant(self.payload)
         except ValueError as exc:
@@ -320,7 +321,7 @@ class RobotSimNode(SharedGraphNode):
         return out
 
     def _plant(self, payload):
-        """Scene dynamics with a payload on the end effector."""
+        """Scene dynamics with a payload on the end effector (or a link)."""
         model = payload_model(self.scene.model, *payload)
         return SceneDynamics(dataclasses.replace(self.scene, model=model))
 
@@ -328,11 +329,10 @@ class RobotSimNode(SharedGraphNode):
         values, errors = check_parameters(params, self.specs)
         if errors:
             return SetParametersResult(successful=False, reason=errors)
-        keys = ('payload.mass', 'payload.com', 'payload.inertia')
-        if not any(k in values for k in keys):
+        if not any(k in values for k in PAYLOAD):
             return SetParametersResult(successful=True)
         payload = tuple(values.get(k, old)
-                        for k, old in zip(keys, self.payload))
+                        for k, old in zip(PAYLOAD, self.payload))
         try:
             dyn = self._plant(payload)
         except (ValueError, TypeError) as exc:
