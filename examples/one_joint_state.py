@@ -71,8 +71,9 @@ def main(argv=None):
               file=sys.stderr)
         return 1
     tau = answers[0]
+    width = max([12, *(len(name) for name in tau.name)])
     for name, effort in zip(tau.name, tau.effort):
-        print(f'{name:>12s}  {effort:+.6f}')
+        print(f'{name:>{width}s}  {effort:+.6f}')
     return 0
 
 

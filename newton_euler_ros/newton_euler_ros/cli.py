@@ -16,7 +16,7 @@
 ``newton-euler``: inverse dynamics of a robot from the command line.
 
     newton-euler dynamics ROBOT --q ... [--qd ...] [--qdd ...]
-                                [--wrench fx fy fz nx ny nz]
+                                [--wrench fx fy fz nx ny nz] [--link LINK]
                                 [--wrench-frame base|end_effector] [--json]
     newton-euler dynamics ROBOT --states STATES.json
     newton-euler check ROBOT
@@ -28,7 +28,9 @@
 
 ROBOT is a robot YAML file, the name of a bundled robot, or a URDF file
 (``.urdf``, or XML under any name, with ``--base LINK --tip LINK`` to
-choose the chain).  Every error is one line on stderr.  Exit status, the
+choose the chain; without ``--tip`` the whole tree below the base: every
+joint, mimic joints following their leaders, ``--link`` naming the link
+of a wrench).  Every error is one line on stderr.  Exit status, the
 same for every command (docs/cli.md): 0 done; 1 the inputs were usable
 but the work failed (the ROS graph did not answer: no subscriber or
 publisher in time, nothing recorded; an internal error); 2 an input is
@@ -103,16 +105,46 @@ def _state_vector(values, n, option):
     return np.array(x)
 
 
-def evaluate(model, q, qd, qdd, wrench, wrench_frame):
-    """All terms at one state, as plain Python lists (JSON-ready)."""
-    tau = inverse_dynamics(model, q, qd, qdd, wrench, wrench_frame)
+def _at_link(model, wrench, wrench_frame, link):
+    """
+    Return (wrench, wrench_frame) the dynamics take, at ``link`` or not.
+
+    With ``link`` the wrench acts there (``end_effector`` axes are the
+    link's own); a tree with several tips has no end effector, so a
+    wrench needs a link.
+    """
+    if link is None:
+        if wrench is not None and model.tool_body is None:
+            raise CliError(f'{model.name} has several tips and no end '
+                           f'effector: give --link LINK for --wrench')
+        return wrench, wrench_frame
+    axes = 'base' if wrench_frame == 'base' else 'link'
+    return (None if wrench is None else {link: wrench}), {link: axes}
+
+
+def evaluate(model, q, qd, qdd, wrench, wrench_frame, link=None):
+    """
+    All terms at one state, as plain Python lists (JSON-ready).
+
+    ``jacobian`` is the end effector's, or ``link``'s; None for a tree
+    with several tips and no ``link``.
+    """
+    w, frame = _at_link(model, wrench, wrench_frame, link)
+    if link is not None:
+        J = jacobian(model, q, link, axes=frame[link])
+    elif model.tool_body is not None:
+        J = jacobian(model, q, wrench_frame)
+    else:
+        J = None
+    tau = inverse_dynamics(model, q, qd, qdd, w,
+                           frame if w is not None else 'base')
     return {
         'joint_names': list(model.joint_names),
         'tau': tau.tolist(),
         'mass_matrix': mass_matrix(model, q).tolist(),
         'coriolis_matrix': coriolis_matrix(model, q, qd).tolist(),
         'gravity': gravity_torques(model, q).tolist(),
-        'jacobian': jacobian(model, q, wrench_frame).tolist(),
+        'jacobian': None if J is None else J.tolist(),
     }
 
 
@@ -161,8 +193,20 @@ def _source(model):
     if model.is_dh:
         return f'{model.convention} DH'
     report = model.info.get('urdf', {})
+    if report.get('tree'):
+        mimic = len(report.get('mimic', ()))
+        return (f'URDF tree below {report.get("base", "?")} ('
+                + (f'one tip, {report["tip"]}' if report.get('tip') else
+                   'several tips')
+                + (f'; {model.nb} moving joints, {mimic} of them mimic'
+                   if mimic else '') + ')')
     return (f'URDF chain {report.get("base", "?")} -> '
             f'{report.get("tip", "?")}')
+
+
+def _types(model):
+    """Return the joint type of each coordinate (a tree's independent joints)."""
+    return [model.joint_types[b] for b in model.independent]
 
 
 def _warn(found):
@@ -183,19 +227,24 @@ def _load(args):
         raise
 
 
-def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
+def format_table(model, result, q, qd, qdd, wrench, wrench_frame,
+                 link=None):
     """Return a human-readable, multi-line report of one evaluation."""
     names = result['joint_names']
+    types = _types(model)
     D = np.array(result['mass_matrix'])
     C = np.array(result['coriolis_matrix'])
     g = np.array(result['gravity'])
-    J = np.array(result['jacobian'])
+    J = None if result['jacobian'] is None else np.array(result['jacobian'])
     jtf = J.T @ wrench if wrench is not None else np.zeros(len(names))
     lines = [f'{model.name}: {model.n} joints, {_source(model)}, '
              f'gravity {model.gravity.tolist()} m/s^2 (base frame)']
+    where = 'end-effector' if link is None else f'{link!r}'
+    axes = wrench_frame if link is None or wrench_frame == 'base' else \
+        'its own'
     if wrench is not None:
-        lines.append(f'end-effector wrench (exerted by the robot, '
-                     f'{wrench_frame} axes): {wrench.tolist()}')
+        lines.append(f'{where} wrench (exerted by the robot, '
+                     f'{axes} axes): {wrench.tolist()}')
     lines.append('')
     head = ('joint', 'type', 'q', 'qd', 'qdd', 'D qdd', 'C qd', 'g',
             'J^T F', 'tau')
@@ -203,10 +252,10 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
     lines.append(f'{head[0]:<{w}}{head[1]:<10}' + ''.join(f'{h:>13}'
                                                           for h in head[2:]))
     for j, name in enumerate(names):
-        unit = 'N m' if model.joint_types[j] == 'revolute' else 'N'
+        unit = 'N m' if types[j] == 'revolute' else 'N'
         row = (q[j], qd[j], qdd[j], (D @ qdd)[j], (C @ qd)[j], g[j], jtf[j],
                result['tau'][j])
-        lines.append(f'{name:<{w}}{model.joint_types[j][:9]:<10}'
+        lines.append(f'{name:<{w}}{types[j][:9]:<10}'
                      + ''.join(_fmt(v) for v in row) + f'  {unit}')
     lines.append('tau = D qdd + C qd + g + J^T F  (N m for revolute, '
                  'N for prismatic joints)')
@@ -217,8 +266,14 @@ def format_table(model, result, q, qd, qdd, wrench, wrench_frame):
                            names, C)
     lines.append('')
     rows = ['vx', 'vy', 'vz', 'wx', 'wy', 'wz']
-    lines += _matrix_lines(f'Jacobian J(q) of the end-effector origin '
-                           f'({wrench_frame} axes):', rows, J, names)
+    if J is None:
+        lines.append('(no Jacobian: the tree has several tips; --link '
+                     'LINK names one)')
+    else:
+        origin = 'the end-effector origin' if link is None else \
+            f'the origin of {link!r}'
+        lines += _matrix_lines(f'Jacobian J(q) of {origin} ({axes} axes):',
+                               rows, J, names)
     return '\n'.join(lines)
 
 
@@ -235,7 +290,7 @@ def cmd_dynamics(args):
         for st in _load_states(args.states, n):
             wrench = st['wrench'] if st['wrench'].any() else None
             results.append(evaluate(model, st['q'], st['qd'], st['qdd'],
-                                    wrench, args.wrench_frame))
+                                    wrench, args.wrench_frame, args.link))
         print(json.dumps(results))
         return 0
     if args.q is None:
@@ -246,30 +301,29 @@ def cmd_dynamics(args):
     qdd = _state_vector(args.qdd, n, '--qdd')
     wrench = (np.array(_numbers(args.wrench, '--wrench'))
               if args.wrench is not None else None)
-    result = evaluate(model, q, qd, qdd, wrench, args.wrench_frame)
+    result = evaluate(model, q, qd, qdd, wrench, args.wrench_frame,
+                      args.link)
     if args.json:
         print(json.dumps(result))
     else:
         print(format_table(model, result, q, qd, qdd, wrench,
-                           args.wrench_frame))
+                           args.wrench_frame, args.link))
     return 0
 
 
 def cmd_check(args):
     model, found, path = _load(args)
-    types = ''.join('R' if t == 'revolute' else 'P'
-                    for t in model.joint_types)
+    types = ''.join('R' if t == 'revolute' else 'P' for t in _types(model))
     print(f'{path}: OK')
     print(f'  name: {model.name}')
     print(f'  joints: {model.n} ({types}), {_source(model)}')
     print(f'  joint names: {", ".join(model.joint_names)}')
     report = model.info.get('urdf')
     if report and report.get('tree'):       # the whole tree below base
-        edges = []
-        for jname, link in zip(report['chain'], report['chain_links']):
-            edges.append(f'{report["parent_links"][jname]} -[{jname}]-> '
-                         f'{link}')
-        print(f'  tree below {report["base"]}: {", ".join(edges)}')
+        for line in tree_lines(model, report):
+            print(f'  {line}')
+        print(f'  continuous joints: '
+              f'{", ".join(report["continuous"]) or "none"}')
     elif report:
         chain = [report['base']]
         for jname, link in zip(report['chain'], report['chain_links']):
@@ -290,6 +344,35 @@ def cmd_check(args):
     for message in found:
         print(f'  {"note" if message in notes else "warning"}: {message}')
     return 0
+
+
+def tree_lines(model, report):
+    """
+    Return the tree below the base, one joint a line, indented by depth.
+
+    Each line: the joint, its type (a mimic joint's multiplier, leader
+    and offset; a fixed joint merged into its parent's body) and the
+    link it carries.
+    """
+    depth = {report['base']: 0}
+    kinds = dict(zip(model.moving_joints, model.joint_types))
+    kinds.update((j, 'continuous') for j in report['continuous'])
+    base = report['base']
+    lines = [f"tree below {base} (depth first, each link's joints in URDF "
+             f"order: the model's joint order):",
+             f'  {report["base"]}']
+    for jname, link in zip(report['chain'], report['chain_links']):
+        d = depth[report['parent_links'][jname]] + 1
+        depth[link] = d
+        if jname in report['mimic']:
+            leader, mult, offset = report['mimic'][jname]
+            kind = (f'{kinds[jname]}, mimic: {mult:g} x {leader}'
+                    + (f' {"+" if offset >= 0 else "-"} {abs(offset):g}'
+                       if offset else ''))
+        else:
+            kind = kinds.get(jname, 'fixed, merged')
+        lines.append(f'{"  " * (d + 1)}{jname} ({kind}) -> {link}')
+    return lines
 
 
 def cmd_simulate(args):
@@ -319,8 +402,9 @@ def cmd_simulate(args):
     print(f'energy drift: {summary["energy_drift_max"]:.3e} J '
           f'({summary["energy_drift_relative"]:.1e} of the energy scale)')
     print('final state:')
+    w = max(12, *(len(x) for x in names))       # names are never cut
     for j, name in enumerate(names):
-        print(f'  {name:<12} q {summary["final_q"][j]:>12.6f}   '
+        print(f'  {name:<{w}} q {summary["final_q"][j]:>12.6f}   '
               f'qd {summary["final_qd"][j]:>12.6f}')
     return 0
 
@@ -336,8 +420,19 @@ def cmd_feedforward(args):
                          f'"joint_names" and "points"')
     wrench = (np.array(_numbers(args.wrench, '--wrench'))
               if args.wrench is not None else None)
-    print(json.dumps(fill_efforts(model, trajectory, wrench,
-                                  args.wrench_frame, where=f'{path}: ')))
+    wrench, frame = _at_link(model, wrench, args.wrench_frame, args.link)
+    hold = None
+    if (model.info.get('urdf') or {}).get('tree'):
+        # a whole robot: the joints the trajectory leaves out stay at zero
+        hold = np.zeros(model.n)
+        names = trajectory.get('joint_names')
+        left = [j for j in model.joint_names
+                if isinstance(names, list) and j not in names]
+        if left:
+            print(f'note: joints not in the trajectory held at 0, at rest: '
+                  f'{", ".join(left)}', file=sys.stderr)
+    print(json.dumps(fill_efforts(model, trajectory, wrench, frame,
+                                  where=f'{path}: ', hold=hold)))
     return 0
 
 
@@ -364,7 +459,16 @@ def _chain_options(parser):
                              'the root link)')
     parser.add_argument('--tip', metavar='LINK',
                         help='URDF only: last link of the chain, the end '
-                             'effector (default: the single leaf)')
+                             'effector (default: none, the whole tree '
+                             'below the base)')
+
+
+def _link_option(parser):
+    parser.add_argument('--link', metavar='LINK',
+                        help='URDF only: the link the wrench acts at and '
+                             'whose Jacobian is printed (default: the end '
+                             'effector; a tree with several tips needs it '
+                             'for --wrench)')
 
 
 def cmd_robots(_args):
@@ -399,7 +503,9 @@ def build_parser():
                           'environment (N, N m), moment about its origin')
     dyn.add_argument('--wrench-frame', choices=('base', 'end_effector'),
                      default='base', help='axes of --wrench and of the '
-                                          'Jacobian (default base)')
+                                          'Jacobian (default base; '
+                                          "end_effector: the frame's own)")
+    _link_option(dyn)
     dyn.add_argument('--json', action='store_true',
                      help='print one JSON object')
     dyn.add_argument('--states', metavar='FILE.json',
@@ -440,7 +546,9 @@ def build_parser():
                     help='wrench the end effector exerts along the whole '
                          'trajectory')
     ff.add_argument('--wrench-frame', choices=('base', 'end_effector'),
-                    default='base')
+                    default='base', help='axes of --wrench (default base; '
+                                         "end_effector: the frame's own)")
+    _link_option(ff)
     _chain_options(ff)
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')

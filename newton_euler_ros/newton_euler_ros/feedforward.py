@@ -63,11 +63,15 @@ class JointOrder:
     ----------
     model_joints : names in the model's order (the dynamics' order).
     output_joints : names in the order results are published, a
-        permutation of ``model_joints``.
+        permutation of ``model_joints``; with ``subset`` some of them
+        (the commanded joints), the others following in model order.
+    followers : {mimic joint: (leader, ...)}: named in the output, one is
+        refused with its leader's name.
 
     """
 
-    def __init__(self, model_joints, output_joints=None, max_names=0):
+    def __init__(self, model_joints, output_joints=None, max_names=0,
+                 subset=False, followers=None):
         self.model_joints = tuple(model_joints)
         #: longer name lists are rejected before any per-name work
         self.max_names = max_names or 4 * len(self.model_joints) + 16
@@ -75,13 +79,23 @@ class JointOrder:
         if len(set(output)) != len(output):
             dup = next(j for j in output if output.count(j) > 1)
             raise ValueError(f'joints: {dup!r} is listed twice')
-        if set(output) != set(self.model_joints):
-            missing = sorted(set(self.model_joints) - set(output))
-            extra = sorted(set(output) - set(self.model_joints))
+        mimic = [j for j in output if j in (followers or {})]
+        if mimic:
+            raise ValueError(f'joints: {mimic[0]!r} is a mimic joint (it '
+                             f'follows {followers[mimic[0]][0]!r}): its '
+                             f'torque acts through its leader')
+        missing = sorted(set(self.model_joints) - set(output))
+        extra = sorted(set(output) - set(self.model_joints))
+        if extra or (missing and not subset):
             raise ValueError(
-                'joints: must name every joint of the robot exactly once'
-                + (f'; missing {missing}' if missing else '')
+                ('joints: must name every joint of the robot exactly once'
+                 if not subset else 'joints: must name joints of the robot')
+                + (f'; missing {missing}' if missing and not subset else '')
                 + (f'; not in the robot: {extra}' if extra else ''))
+        #: ~/torque_command carries the first ``command`` joints of the
+        #: output: those named (a subset on a whole robot), then the rest
+        self.command = len(output)
+        output += tuple(j for j in self.model_joints if j not in output)
         self.output_joints = output
         index = {name: i for i, name in enumerate(self.model_joints)}
         #: out[k] = model_vector[self.to_output[k]]
@@ -323,18 +337,18 @@ def check_payload(mass, com, inertia6):
     return mass, com, inertia
 
 
-def payload_model(model, mass, com, inertia6):
+def payload_model(model, mass, com, inertia6, link=''):
     """
     Return the model with a payload on the end effector, or ValueError.
 
-    Merged into the last link by
-    :func:`~newton_euler_ros.core.model.with_payload`, the scenes' code;
-    no payload (all zeros) returns ``model`` itself.
+    Merged into the last link (or the body carrying ``link``, a link of a
+    URDF model) by :func:`~newton_euler_ros.core.model.with_payload`, the
+    scenes' code; no payload (all zeros) returns ``model`` itself.
     """
     mass, com, inertia = check_payload(mass, com, inertia6)
     if mass == 0.0 and not inertia.any():
         return model
-    return with_payload(model, mass, com, inertia)
+    return with_payload(model, mass, com, inertia, link or None)
 
 
 def rigid_frames(model):
@@ -493,6 +507,9 @@ class FeedforwardComputer:
     #: ``core.drives.Drives`` to add (friction, offset, rotor inertia),
     #: or None; set by :meth:`from_parameters` with ``drives.compensate``
     drives = None
+    #: a whole robot's ``whole_robot.JointStateMerger`` (partial joint
+    #: states from several drivers), or None: the node sets it
+    merger = None
 
     def _torques(self, q, qd, qdd, w, frame, out=None):
         """Inverse dynamics with the scene's effects, or all of them."""
@@ -515,6 +532,10 @@ class FeedforwardComputer:
         for frame in ('base', 'end_effector'):
             inverse_dynamics(self.model, z, z, z, np.zeros(6), frame,
                              ws=self.ws)
+        if not isinstance(self.wrench, WrenchInput):    # at links
+            link = next(iter(self.model.link_frames))
+            inverse_dynamics(self.model, z, z, z, {link: np.zeros(6)},
+                             'link', ws=self.ws)
         inverse_dynamics(self.model, z, z, z, ws=self.ws)
         mass_matrix(self.model, z, ws=self.ws)
         coriolis_matrix(self.model, z, z, ws=self.ws)
@@ -541,6 +562,13 @@ class FeedforwardComputer:
         stamp = self.check_stamp(stamp, now)
         q = self.order.gather(names, 'position', position)
         qd = self.order.gather(names, 'velocity', velocity, required=False)
+        return self._state_torques(q, qd, stamp, now)
+
+    def state_torques(self, q, qd, stamp, now):
+        """Output-ordered torques at (q, qd), model order (a whole robot)."""
+        return self._state_torques(q, qd, self.check_stamp(stamp, now), now)
+
+    def _state_torques(self, q, qd, stamp, now):
         if qd is None:
             qd = np.zeros(self.model.n)
         elif self.velocity_bounds is not None:

@@ -51,21 +51,43 @@ ACCELERATION = 20.0         # rad/s^2 (or m/s^2) for the derived bound
 SAMPLES = 64
 
 
+def joint_limits(model):
+    """Return the limits of the model's coordinates (its independent joints)."""
+    return [model.limits[b] for b in model.independent]
+
+
+def _tips(model):
+    """
+    Frames that push on the environment: the end effector, or every leaf.
+
+    A tree with several tips has no end effector; each leaf link (a body
+    that carries no other) can push, so each one's Jacobian counts.
+    """
+    if model.tool_body is not None:
+        return ['end_effector']
+    carried = set(model.parents)
+    return [name for name, (body, T) in (model.link_frames or {}).items()
+            if body >= 0 and body not in carried
+            and np.array_equal(T, np.eye(4))]
+
+
 def derived_effort_bounds(model, seed=0):
     """Per-joint bounds for a robot without effort limits (see above)."""
     rng = np.random.default_rng(seed)
-    lo = np.array([lim.get('lower', -np.pi) for lim in model.limits])
-    hi = np.array([lim.get('upper', np.pi) for lim in model.limits])
+    limits = joint_limits(model)
+    lo = np.array([lim.get('lower', -np.pi) for lim in limits])
+    hi = np.array([lim.get('upper', np.pi) for lim in limits])
     weight = model.total_mass * float(np.linalg.norm(model.gravity))
     push = np.array([weight] * 3 + [0.1 * weight] * 3)
     need = np.zeros(model.n)
+    tips = _tips(model)
     for _ in range(SAMPLES):
         q = rng.uniform(lo, hi)
         g = np.abs(gravity_torques(model, q))
         D = np.abs(mass_matrix(model, q))
-        J = np.abs(jacobian(model, q))
-        need = np.maximum(need, g + ACCELERATION * D.sum(axis=1)
-                          + J.T @ push)
+        pushed = sum(np.abs(jacobian(model, q, tip, axes='base')).T @ push
+                     for tip in tips)
+        need = np.maximum(need, g + ACCELERATION * D.sum(axis=1) + pushed)
     return 2.0 * need
 
 
@@ -85,7 +107,8 @@ def effort_bounds(model, override=()):
                              f'(one per joint, output order), got '
                              f'{list(override)[:n + 1]}')
         return values, ['parameter'] * n
-    bounds = np.array([lim.get('effort', np.nan) for lim in model.limits],
+    bounds = np.array([lim.get('effort', np.nan)
+                       for lim in joint_limits(model)],
                       dtype=np.float64).reshape(n)
     sources = ['robot' if np.isfinite(b) else 'derived' for b in bounds]
     if 'derived' in sources:
@@ -96,7 +119,8 @@ def effort_bounds(model, override=()):
 
 def velocity_bounds(model, factor=2.0, fallback=20.0):
     """Speeds above these are implausible (model order)."""
-    vel = np.array([lim.get('velocity', np.nan) for lim in model.limits],
+    vel = np.array([lim.get('velocity', np.nan)
+                    for lim in joint_limits(model)],
                    dtype=np.float64).reshape(model.n)
     return np.where(np.isfinite(vel), factor * vel, fallback)
 

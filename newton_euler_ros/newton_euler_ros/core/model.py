@@ -450,29 +450,41 @@ def convert_convention(model, convention):
                          inertia=inertia, base=base, tool=tool)
 
 
-def with_payload(model, mass, com, inertia):
+def with_payload(model, mass, com, inertia, link=None):
     """
-    Return the model with a rigid payload fixed to the end effector.
+    Return the model with a rigid payload fixed to the end effector or a link.
 
-    The payload (``mass`` kg, centre of mass ``com`` in end-effector axes
-    and origin, ``inertia`` 3x3 about its centre of mass in end-effector
-    axes) is merged into the link carrying the end effector (the last one
-    of a chain) by the parallel-axis theorem, so the dynamics cost nothing
-    extra.  A model without an end effector (a tree with several tips)
-    raises ValueError.
+    The payload (``mass`` kg, centre of mass ``com`` in the frame's axes
+    and origin, ``inertia`` 3x3 about its centre of mass in the frame's
+    axes) is merged into the body carrying the frame (the last link of a
+    chain for the end effector) by the parallel-axis theorem, so the
+    dynamics cost nothing extra.  The frame is the end effector, or
+    ``link``, a name of ``model.link_frames`` (any link of a URDF tree: a
+    gripper of a dual-arm robot).  A model without an end effector (a
+    tree with several tips) and no ``link`` raises ValueError, as does an
+    unknown link.
     """
     if not mass >= 0.0:
         raise ValueError(f'payload mass must be >= 0, got {mass}')
-    b = model.tool_body
+    if link:
+        frames = model.link_frames or {}
+        if link not in frames:
+            raise ValueError(f'{model.name}: no link {link!r} to carry the '
+                             f'payload')
+        b, T = frames[link]
+    else:
+        b, T = model.tool_body, model.tool
     if b is None:
         raise ValueError(f'{model.name}: the model has no end effector (a '
-                         f'tree with several tips): load it with a tip link')
-    if b < 0:       # an end effector fixed to the base carries nothing
+                         f'tree with several tips): name the link that '
+                         f'carries the payload, or load it with a tip link')
+    if b < 0:       # a frame fixed to the base carries nothing
         return model
+    T = np.asarray(T, dtype=np.float64)
     m, c, I_new = merge_bodies([
         (model.mass[b], model.com[b], model.inertia[b], np.eye(3),
          np.zeros(3)),
-        (mass, com, inertia, model.tool[:3, :3], model.tool[:3, 3])])
+        (mass, com, inertia, T[:3, :3], T[:3, 3])])
     if m == 0.0:
         return model
     masses = np.array(model.mass)

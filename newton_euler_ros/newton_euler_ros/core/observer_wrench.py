@@ -34,9 +34,11 @@ import math
 from numba import njit
 import numpy as np
 
-from .calling import (F8, MAT, out_array, PACKED, Refused, status_error,
-                      strict_entry, VEC, vector)
+from .calling import (BOOL, F8, INT, MAT, out_array, PACKED, Refused,
+                      status_error, strict_entry, TARGET, VEC, vector)
 from .dynamics import jacobian
+from .errors import DynamicsInputError
+from .frames import AXES, frame_target
 from .kernels import (cholesky_solve, F_ROWS, F_TOOL, F_TREE, run_jacobian,
                       SIZE, T_TOOL)
 from .kernels._jit import ENTRY, uses_kernels
@@ -97,15 +99,23 @@ def _dls_wrench(J, r, damping, A, y, F):
 
 @njit(**ENTRY)
 def _wrench(P, q, r, damping, ws, Ts, J, A, y, F):
-    """
-    J(q) and the damped least-squares wrench in one compiled call.
-
-    A kernel status code for q (or SIZE + 1 for r), else -1 with F the
-    wrench, or zeros when the solve fails.
-    """
+    """Return the end effector's wrench (:func:`_wrench_at`), base axes."""
     frames = P[P.shape[0] - F_ROWS:]        # the end effector's Jacobian
-    code = run_jacobian(P, q, int(frames[F_TREE, T_TOOL]), frames[F_TOOL],
-                        False, ws, Ts, J)
+    return _wrench_at(P, q, r, damping, int(frames[F_TREE, T_TOOL]),
+                      frames[F_TOOL], False, ws, Ts, J, A, y, F)
+
+
+@njit(**ENTRY)
+def _wrench_at(P, q, r, damping, body, target, local, ws, Ts, J, A, y, F):
+    """
+    J(q) of a frame and the damped least-squares wrench in one call.
+
+    The frame on joint ``body``'s link at pose ``target`` (the Jacobian
+    kernel's), its axes or the base's (``local``).  A kernel status code
+    for q (or SIZE + 1 for r), else -1 with F the wrench, or zeros when
+    the solve fails.
+    """
+    code = run_jacobian(P, q, body, target, local, ws, Ts, J)
     if code >= 0:
         return code
     if r.shape[0] != J.shape[1] or F.shape[0] != 6:
@@ -118,9 +128,11 @@ def _wrench(P, q, r, damping, ws, Ts, J, A, y, F):
 
 _wrench_strict = strict_entry(_wrench, PACKED, VEC, VEC, F8, MAT, MAT, MAT,
                               MAT, VEC, VEC)
+_wrench_at_strict = strict_entry(_wrench_at, PACKED, VEC, VEC, F8, INT,
+                                 TARGET, BOOL, MAT, MAT, MAT, MAT, VEC, VEC)
 
 
-def external_wrench(obs, q, r, out=None):
+def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
     """
     Return F_ext (6,), the wrench the environment applies to the tool.
 
@@ -129,7 +141,16 @@ def external_wrench(obs, q, r, out=None):
     dynamics' input convention), the damped least-squares solution of
     ``J(q)^T F = r``.  Zeros if the solve fails (never NaN).  One
     compiled call (``_wrench``): J(q), then the solve.
+
+    With ``frame``, a link of the model (a gripper of a tree; every
+    URDF link is named) or ``'end_effector'``: the wrench at that frame,
+    the moment about its origin, in base axes or the frame's own
+    (``axes='link'``), from J of that frame.  Only the joints between it
+    and the base take part; on a tree a push elsewhere that shows on
+    those joints (a torso's) is read as this frame's.
     """
+    if frame is not None:
+        return _wrench_at_frame(obs, q, r, out, frame, axes)
     F = np.empty(6) if out is None else out
     try:
         code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
@@ -163,3 +184,27 @@ def felt_directions(obs, q, tol=1e-6):
     if not s.size or not s[0] > 0.0:
         return np.zeros((6, 0))
     return U[:, s > tol * s[0]]
+
+
+def _wrench_at_frame(obs, q, r, out, frame, axes):
+    if axes not in AXES:
+        raise DynamicsInputError(f"axes must be 'base' or 'link', got "
+                                 f'{axes!r}')
+    body, target = frame_target(obs.model, frame)
+    local = axes == 'link'
+    F = np.empty(6) if out is None else out
+    try:
+        code = _wrench_at_strict(obs._packed, q, r, obs.damping, body,
+                                 target, local, obs.ws.ws, obs.ws.frames,
+                                 obs.J, obs._A, obs._y, F)
+    except Refused:                 # not float64 arrays: convert, again
+        code = None
+    if code is None or code >= 0:
+        q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
+            out, (6,))
+        code = _wrench_at_strict(obs._packed, q, r, obs.damping, body,
+                                 target, local, obs.ws.ws, obs.ws.frames,
+                                 obs.J, obs._A, obs._y, F)
+        if code >= 0:
+            raise status_error(code, (q,))
+    return F

@@ -37,7 +37,7 @@ import math
 
 import numpy as np
 
-from .dynamics import inverse_dynamics_batch
+from .dynamics import inverse_dynamics_batch, wrench_torques
 from .errors import DynamicsInputError
 
 MAX_POINTS = 100000
@@ -79,22 +79,39 @@ def differentiate(times, values):
     return out
 
 
-def _column_map(model, joint_names, where):
+def _column_map(model, joint_names, where, partial=False):
+    """
+    Return (cols, named): the trajectory's columns of the model's joints.
+
+    ``named`` are the model indices of the joints the trajectory names, in
+    model order, and ``cols`` their columns in the trajectory.  Every
+    joint must be named unless ``partial``.
+    """
     names = list(joint_names)
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
         raise TrajectoryError(f'{where}joint_names: {dup!r} appears twice')
     unknown = [n for n in names if n not in model.joint_names]
     if unknown:
+        followers = {model.moving_joints[b]: model.moving_joints[m[0]]
+                     for b, m in enumerate(model.mimic or ()) if m}
+        if unknown[0] in followers:
+            raise TrajectoryError(
+                f'{where}joint_names: {unknown[0]!r} is a mimic joint (it '
+                f'follows {followers[unknown[0]]!r}): name its leader')
         raise TrajectoryError(f'{where}joint_names: unknown joints '
                               f'{unknown[:5]} (the robot has '
                               f'{list(model.joint_names)})')
     missing = [n for n in model.joint_names if n not in names]
-    if missing:
+    if missing and not partial:
         raise TrajectoryError(f'{where}joint_names: missing joints '
                               f'{missing[:5]}; every joint of the robot is '
                               f'needed')
-    return np.array([names.index(n) for n in model.joint_names])
+    named = np.array([k for k, n in enumerate(model.joint_names)
+                      if n in names], dtype=np.intp)
+    cols = np.array([names.index(model.joint_names[k]) for k in named],
+                    dtype=np.intp)
+    return cols, named
 
 
 def _get(point, key):
@@ -184,15 +201,18 @@ def _point_by_point(points, n, cols, where):
     return times, arrays, given
 
 
-def trajectory_arrays(model, joint_names, points, where=''):
+def trajectory_arrays(model, joint_names, points, where='', hold=None):
     """
     Validate points; return (times, Q, QD, QDD) in the model's joint order.
 
     ``points`` is a sequence of mappings (or objects with the same
     attributes) with ``time_from_start`` and the three fields; ``where``
-    prefixes every error message (a file name, or the topic).
+    prefixes every error message (a file name, or the topic).  With
+    ``hold`` (n positions, model order) the trajectory may name some of
+    the joints only: the others stay at ``hold``, at rest (one arm of a
+    dual-arm robot moves, the other is held where it was measured).
     """
-    cols = _column_map(model, joint_names, where)
+    cols, named = _column_map(model, joint_names, where, hold is not None)
     m = len(points)
     if m == 0:
         raise TrajectoryError(f'{where}points: the trajectory has no points')
@@ -217,38 +237,59 @@ def trajectory_arrays(model, joint_names, points, where=''):
         times, Q)
     QDD = (arrays['accelerations'] if given['accelerations']
            else differentiate(times, QD))
-    return times, Q, QD, QDD
+    if n == model.n:
+        return times, Q, QD, QDD
+    full = [np.zeros((m, model.n)) for _ in range(3)]
+    full[0][:] = np.asarray(hold, dtype=np.float64)
+    for X, part in zip(full, (Q, QD, QDD)):
+        X[:, named] = part
+    return (times, *full)
 
 
 def trajectory_efforts(model, joint_names, points, wrench=None,
                        wrench_frame='base', where='', ws=None, drives=None,
-                       gravity=True):
+                       gravity=True, hold=None):
     """
-    Efforts (m, n) at every point, in the trajectory's joint order.
+    Efforts (m, k) at every point, for the k joints of the trajectory.
 
-    tau = D qdd + C qd + g (+ J^T F_e for a ``wrench`` held along the whole
-    trajectory, + the drive terms of ``drives``, a ``core.drives.Drives``;
-    without g when not ``gravity``: a robot that adds it itself), one
-    batched call; raises :class:`TrajectoryError` for a bad trajectory
-    (one line naming the point and the field).
+    In the trajectory's joint order: tau = D qdd + C qd + g (+ J^T F_e for
+    a ``wrench`` held along the whole trajectory, an end-effector [f; n]
+    or wrenches at links ``{link: [f; n]}`` as
+    :func:`~newton_euler_ros.core.dynamics.inverse_dynamics` takes them;
+    + the drive terms of ``drives``, a ``core.drives.Drives``; without g
+    when not ``gravity``: a robot that adds it itself), one batched call;
+    with ``hold``, the joints the trajectory does not name stay there at
+    rest (:func:`trajectory_arrays`).  Raises :class:`TrajectoryError`
+    for a bad trajectory (one line naming the point and the field).
     """
-    _, Q, QD, QDD = trajectory_arrays(model, joint_names, points, where)
+    _, Q, QD, QDD = trajectory_arrays(model, joint_names, points, where,
+                                      hold)
     W = None
-    if wrench is not None:
+    if wrench is not None and not isinstance(wrench, dict):
         W = np.tile(np.asarray(wrench, dtype=np.float64), (Q.shape[0], 1))
-    tau = inverse_dynamics_batch(model, Q, QD, QDD, W, wrench_frame,
+    tau = inverse_dynamics_batch(model, Q, QD, QDD, W,
+                                 'base' if W is None else wrench_frame,
                                  gravity=gravity, ws=ws)
+    if isinstance(wrench, dict):
+        for k in range(Q.shape[0]):
+            tau[k] += wrench_torques(model, Q[k], wrench, wrench_frame,
+                                     ws=ws)
     if drives is not None:
         tau = tau + drives.torques(QD, QDD)
-    cols = _column_map(model, joint_names, where)
-    out = np.empty_like(tau)
-    out[:, cols] = tau
+    cols, named = _column_map(model, joint_names, where, hold is not None)
+    out = np.empty((tau.shape[0], len(cols)))
+    out[:, cols] = tau[:, named]
     return out
 
 
 def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
-                 where=''):
-    """Return a JSON-style trajectory dict with ``effort`` in every point."""
+                 where='', hold=None):
+    """
+    Return a JSON-style trajectory dict with ``effort`` in every point.
+
+    ``wrench``, ``wrench_frame`` and ``hold`` as :func:`trajectory_efforts`
+    takes them.
+    """
     names = trajectory.get('joint_names')
     if not isinstance(names, list) or not all(isinstance(x, str)
                                               for x in names):
@@ -264,7 +305,7 @@ def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
             raise TrajectoryError(f'{where}points[{k}]: unknown key '
                                   f'{sorted(unknown)[0]!r}')
     efforts = trajectory_efforts(model, names, points, wrench, wrench_frame,
-                                 where)
+                                 where, hold=hold)
     out = dict(trajectory)
     out['points'] = [dict(p, effort=e.tolist())
                      for p, e in zip(points, efforts)]
@@ -294,7 +335,7 @@ class TrajectoryFollower:
     def set(self, joint_names, start, points):  # noqa: A003 (JTC's verb)
         """Add a trajectory starting at ``start`` (s); raises on bad input."""
         times, Q, QD, _ = trajectory_arrays(self.model, joint_names, points)
-        cols = _column_map(self.model, joint_names, '')
+        cols, _ = _column_map(self.model, joint_names, '')
         eff = np.zeros_like(Q)
         efforts = [p.get('effort') if isinstance(p, dict)
                    else getattr(p, 'effort', None) for p in points]

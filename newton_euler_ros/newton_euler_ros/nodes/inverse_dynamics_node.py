@@ -16,7 +16,10 @@
 inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
-result is published.  docs/node.md describes the whole interface.
+result is published.  docs/node.md describes the whole interface.  With a
+URDF and no tip_link it serves the whole robot below base_link (a tree,
+mimic joints): joint states from several drivers merged, wrenches at the
+links their frames name (``whole_robot``; docs/node.md, "Whole robots").
 
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
@@ -52,7 +55,7 @@ from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
-                     declare_parameters, plain, qos_profile, QUIET,
+                     declare_parameters, qos_profile, QUIET,
                      release_memory, run_node, SharedGraphNode)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
@@ -63,19 +66,24 @@ from ..feedforward import (check_payload, clip, FeedforwardComputer,
                            InputRejected, JointOrder, payload_model,
                            ReferenceTrajectory, rigid_frames, WrenchInput)
 from ..parameters import load_specs
-from ..safety import effort_bounds, wrench_bounds
+from ..safety import effort_bounds, TorqueGuard, wrench_bounds
 from ..sim.scene import load_scene
+from ..whole_robot import followers_of, JointStateMerger, LinkWrenches
 
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
             'service_calls', 'service_failures', 'internal_error',
             'no_model', 'descriptions_loaded', 'descriptions_rejected',
             'trajectories', 'payload_changes', 'implausible', 'over_limit',
-            'oversized', 'bad_stamp', 'other_joints')
+            'oversized', 'bad_stamp', 'other_joints', 'mimic_mismatch',
+            'held')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
 
 
 def _seconds(stamp):
@@ -104,8 +112,7 @@ class InverseDynamicsNode(SharedGraphNode):
                 f'empty mode), not {p["mode"]}')
         self.mode = p['mode'] or ('full' if p['acceleration_source'] ==
                                   'reference' else 'gravity_coriolis')
-        self.payload = (p['payload.mass'], p['payload.com'],
-                        p['payload.inertia'])
+        self.payload = tuple(p[k] for k in PAYLOAD)
         if (p['base_link'] or p['tip_link']) and p['scene']:
             raise ConfigurationError('base_link/tip_link: not with scene '
                                      '(the scene names its robot)')
@@ -199,12 +206,14 @@ class InverseDynamicsNode(SharedGraphNode):
         model = payload_model(bare, *(payload or self.payload))
         if scene is not None:
             scene = dataclasses.replace(scene, model=model)
+        whole = self._whole(bare) and scene is None
         if previous is not None:
             order, wrench = previous.order, previous.wrench
             reference = previous.reference
         else:
             order = JointOrder(model.joint_names, p['joints'] or None,
-                               p['limits.max_names'])
+                               p['limits.max_names'], subset=whole,
+                               followers=followers_of(model))
             wrench = None
             reference = (ReferenceTrajectory(order)
                          if self.mode == 'full' else None)
@@ -220,20 +229,43 @@ class InverseDynamicsNode(SharedGraphNode):
             override = model_order
         bounds, sources = effort_bounds(model, override)
         if wrench is None:
-            wrench = self._wrench_input(p, model, bounds)
+            wrench = self._wrench_input(p, model, bounds, whole)
         ff = FeedforwardComputer.from_parameters(
             p, model, order, wrench, bounds, sources, reference, scene,
             self.mode, bare_model=bare,
             bare_scene=scene if previous is None else previous.bare_scene)
+        if previous is not None:
+            ff.merger = previous.merger
+        elif whole:
+            ff.merger = JointStateMerger(
+                model, order.output_joints[:order.command],
+                p['joint_states.hold'], p['joint_states.mimic_tolerance'],
+                p['limits.max_names'])
         return ff
+
+    def _whole(self, model):
+        """Say whether a model is a whole robot (a URDF tree, no tip link)."""
+        report = model.info.get('urdf') if isinstance(model.info, dict) \
+            else None
+        return bool(report and report.get('tree')
+                    and not self.params['tip_link'])
 
     def _log_model(self, ff, source):
         model = ff.model
         effects = (ff.scene.effects.names() if ff.scene is not None
                    else 'all rigid-body')
+        whole = ''
+        if ff.merger is not None:
+            mimic = [f'{f} follows {lead}' for f, (lead, _, _) in
+                     ff.merger.followers.items()]
+            whole = (f'whole robot, {model.nb} moving joints'
+                     + (f' ({clip(", ".join(mimic), 300)})' if mimic else '')
+                     + f', commanding {ff.order.command} on torque_command;'
+                     f' joints held {self.params["joint_states.hold"]} s; ')
         self.get_logger().info(
             f'{model.name} ({source}): {model.n} joints '
-            f'[{", ".join(ff.output_names)}], mode {self.mode}, effects '
+            f'[{clip(", ".join(ff.output_names), 600)}], {whole}mode '
+            f'{self.mode}, effects '
             f'{effects}, payload {self.payload[0]} kg, wrench frames '
             f'{clip(str(sorted(ff.wrench.frames)), 400)}'
             + ('' if not self.params['drives.compensate'] else
@@ -282,12 +314,19 @@ class InverseDynamicsNode(SharedGraphNode):
                 log(clip(message, 400))
             self.ff = ff        # one reference swap: callbacks see either
             self.counts['descriptions_loaded'] += 1
-            self.model_source = (f'robot_description, {report["base"]} -> '
-                                 f'{report["tip"]}')
+            self.model_source = (
+                f'robot_description, {report["base"]} -> {report["tip"]}'
+                if report['tip'] and not self._whole(model) else
+                f'robot_description, the tree below {report["base"]}')
         self._log_model(ff, self.model_source)
 
     # ---- parameters ----
-    def _wrench_input(self, p, model, bounds):
+    def _wrench_input(self, p, model, bounds, whole):
+        if whole:
+            return LinkWrenches(model, p['wrench.base_frames'],
+                                p['wrench.end_effector_frames'],
+                                p['wrench.link'], p['wrench.convention'],
+                                p['wrench.timeout'], wrench_bounds(bounds))
         return WrenchInput(p['wrench.base_frames'],
                            p['wrench.end_effector_frames'],
                            p['wrench.convention'], p['wrench.timeout'],
@@ -297,18 +336,18 @@ class InverseDynamicsNode(SharedGraphNode):
         values, errors = check_parameters(params, self.specs)
         if errors:
             return SetParametersResult(successful=False, reason=errors)
-        current = {s.name: values.get(s.name,
-                                      self.get_parameter(s.name).value)
+        # (an empty default is declared without a value: self.params has
+        # what the node runs with)
+        current = {s.name: values.get(s.name, self.params[s.name])
                    for s in self.specs if s.name.startswith('wrench.')}
-        current = {k: plain(v) for k, v in current.items()}
-        payload = tuple(values.get(k, self.params[k]) for k in (
-            'payload.mass', 'payload.com', 'payload.inertia'))
+        payload = tuple(values.get(k, self.params[k]) for k in PAYLOAD)
         ff = self.ff
         new_ff = None
         if ff is not None:
             try:
                 new_wrench = self._wrench_input(current, ff.model,
-                                                ff.guard.bounds)
+                                                ff.guard.bounds,
+                                                ff.merger is not None)
                 if payload != self.payload:
                     # a new model and workspace, built here, off the hot
                     # path; everything else carries over
@@ -322,7 +361,7 @@ class InverseDynamicsNode(SharedGraphNode):
                 ff.wrench = new_wrench
         else:
             try:        # no model yet: check the payload values alone
-                check_payload(*payload)
+                check_payload(*payload[:3])
             except ValueError as exc:
                 return SetParametersResult(successful=False,
                                            reason=str(exc))
@@ -333,7 +372,7 @@ class InverseDynamicsNode(SharedGraphNode):
                 self.ff = new_ff
             self.get_logger().info(
                 f'payload now {payload[0]} kg at {list(payload[1])} m '
-                f'(end-effector frame)')
+                f'({payload[3] or "end-effector"} frame)')
         self.params.update(values)
         if 'log_throttle' in values:
             self.log_throttle = values['log_throttle']
@@ -366,13 +405,24 @@ class InverseDynamicsNode(SharedGraphNode):
             return
         try:
             now = self._now()
-            tau = ff.torques(msg.name, msg.position, msg.velocity,
-                             _seconds(msg.header.stamp), now)
+            if ff.merger is not None:       # a whole robot: merge first
+                state = ff.merger.merge(msg.name, msg.position, msg.velocity,
+                                        msg.effort, now)
+                if state is None:           # no commanded joint in it
+                    self.counts['held'] += 1
+                    return
+                tau = ff.state_torques(*state, _seconds(msg.header.stamp),
+                                       now)
+            else:
+                tau = ff.torques(msg.name, msg.position, msg.velocity,
+                                 _seconds(msg.header.stamp), now)
             # the torques left the wrench out once it was too old: say so
             # once, with the first state answered without it
             if ff.wrench.expire(now):
+                which = ('' if ff.merger is None else ' (' + clip(', '.join(
+                    ff.wrench.last_expired), 200) + ')')
                 self._reject('wrench', InputRejected(
-                    'expired', 'the last wrench is older than '
+                    'expired', f'the last wrench{which} is older than '
                     f'{ff.wrench.timeout} s; torques no longer include '
                     f'it'))
         except InputRejected as exc:
@@ -392,7 +442,8 @@ class InverseDynamicsNode(SharedGraphNode):
             if tau is None:
                 return
         values = tau.tolist()
-        self._cmd.data = values
+        k = ff.order.command
+        self._cmd.data = values if k == len(values) else values[:k]
         self.cmd_pub.publish(self._cmd)
         self._torques.header.stamp = msg.header.stamp
         self._torques.name = ff.output_names
@@ -466,7 +517,8 @@ class InverseDynamicsNode(SharedGraphNode):
                                          w, frame, 'trajectory: ', ff.ws,
                                          drives=ff.drives,
                                          gravity=not
-                                         ff.robot_compensates_gravity)
+                                         ff.robot_compensates_gravity,
+                                         hold=self._hold(ff, msg))
         except NewtonEulerError as exc:
             self._reject('trajectory', InputRejected('malformed', str(exc)))
             return
@@ -475,8 +527,13 @@ class InverseDynamicsNode(SharedGraphNode):
             return
         out = efforts.copy()
         exceeded = False
+        # the bounds of the trajectory's joints, in its order
+        where = {name: k for k, name in enumerate(ff.output_names)}
+        guard = TorqueGuard(ff.guard.bounds[[where[name] for name in
+                                             msg.joint_names]],
+                            ff.guard.action)
         for k in range(out.shape[0]):
-            row, over = ff.guard.check(efforts[k])
+            row, over = guard.check(efforts[k])
             exceeded |= over
             if row is None:
                 self._over_limit(ff, 'trajectory effort')
@@ -488,6 +545,19 @@ class InverseDynamicsNode(SharedGraphNode):
             pt.effort = effort.tolist()
         self.traj_pub.publish(msg)
         self.counts['trajectories'] += 1
+
+    @staticmethod
+    def _hold(ff, msg):
+        """Return where a whole robot's joints a trajectory leaves out are."""
+        if ff.merger is None or set(ff.model.joint_names) <= set(
+                msg.joint_names):
+            return None
+        if ff.last_q is None:
+            raise InputRejected(
+                'no_state', f'the trajectory names {len(msg.joint_names)} of '
+                f'the {ff.model.n} joints, and no joint state has arrived '
+                f'yet to hold the others at')
+        return ff.last_q
 
     def _on_compute_dynamics(self, request, response):
         self.counts['service_calls'] += 1

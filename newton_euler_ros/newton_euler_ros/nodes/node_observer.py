@@ -20,8 +20,11 @@ published, :meth:`NodeObserver.observe` runs one observer step on it (its
 efforts converted to joint torques through the URDF's torque constants
 when it has them: a current-sensing arm) and publishes
 ``~/external_torque`` (JointState, effort field), ``~/external_wrench``
-(WrenchStamped, base frame) and, on every change, ``~/contact`` (Bool;
-also at ``observer.contact_period``).  Its state and counters go to
+(WrenchStamped, base frame; or one per link of ``observer.end_effectors``,
+in its axes, frame_id the link) and, on every change, ``~/contact``
+(Bool; also at ``observer.contact_period``).  On a whole robot the
+efforts and velocities are the ones the node's merger holds (every joint
+of the robot, possibly from several drivers).  Its state and counters go to
 ``/diagnostics`` (:meth:`NodeObserver.diagnostics`).  It never raises
 into the node: a sample it cannot use is counted and skipped, and
 JointStates without effort or velocity are reported once.
@@ -71,6 +74,9 @@ class NodeObserver:
         self._torque = JointState()
         self._wrench = WrenchStamped()
         self._wrench_out = np.zeros(6)
+        #: (link, message, buffer) per end effector of
+        #: observer.end_effectors (empty: the end effector, base axes)
+        self._links = []
         node.create_timer(params['observer.contact_period'],
                           self.publish_contact)
         if ff is not None:
@@ -129,8 +135,29 @@ class NodeObserver:
                 or (list(p['wrench.base_frames']) or ['base_link'])[0])
         self._wrench.header.frame_id = base
         self._torque.name = list(model.joint_names)
+        self._links = self._end_effectors(model)
         self.ff, self.obs, self.state = ff, obs, state
         return obs
+
+    def _end_effectors(self, model):
+        """Return (link, message, buffer) of each observer.end_effectors."""
+        links = list(self.params['observer.end_effectors'])
+        unknown = [x for x in links if x not in (model.link_frames or {})]
+        if unknown:
+            raise ValueError(f'observer.end_effectors: {unknown[0]!r} is not '
+                             f'a link of {model.name}')
+        if not links and model.tool_body is None and \
+                'no wrench' not in self.said:
+            self.said.add('no wrench')
+            self.node.get_logger().info(
+                'observer: the robot has several tips and no '
+                'observer.end_effectors: external torques only, no wrench')
+        out = []
+        for link in links:
+            msg = WrenchStamped()
+            msg.header.frame_id = link
+            out.append((link, msg, np.zeros(6)))
+        return out
 
     def _says(self, key, status, text):
         """Set the observer's status; log ``text`` once per kind."""
@@ -141,6 +168,8 @@ class NodeObserver:
 
     def _step(self, ff, msg):
         """Return (residual, wrench, contact before, after) or None."""
+        if ff.merger is not None:
+            return self._merged_step(ff, msg)
         effort = ff.order.gather(msg.name, 'effort', msg.effort,
                                  required=False)
         if effort is None:
@@ -154,6 +183,30 @@ class NodeObserver:
                        'joint_states carry no velocity: the observer cannot '
                        'run (torques go on)')
             return None
+        return self._run(ff, msg, effort)
+
+    def _merged_step(self, ff, msg):
+        """Do the same on a whole robot, from the merger's efforts."""
+        effort, missing = ff.merger.efforts()
+        if effort is None:
+            self._says('effort', f'cannot run: no effort for '
+                       f'{clip(", ".join(missing), 200)}',
+                       f'no effort for joint(s) {clip(", ".join(missing), 300)}'
+                       f' in their latest joint_states: the observer cannot '
+                       f'run (torques go on)')
+            return None
+        unrated = ff.merger.unrated()
+        if unrated:
+            self._says('velocity', f'cannot run: no velocity for '
+                       f'{clip(", ".join(unrated), 200)}',
+                       f'no velocity for joint(s) '
+                       f'{clip(", ".join(unrated), 300)} in their latest '
+                       f'joint_states: the observer cannot run (torques go '
+                       f'on)')
+            return None
+        return self._run(ff, msg, effort)
+
+    def _run(self, ff, msg, effort):
         obs = self.observer_for(ff)
         stamp = _seconds(msg.header.stamp) or \
             self.node.get_clock().now().nanoseconds * 1e-9
@@ -161,7 +214,16 @@ class NodeObserver:
                                          ff.last_qd, effort)
         if what == momentum.DUPLICATE:
             return None
-        F = momentum.external_wrench(obs, ff.last_q, r, out=self._wrench_out)
+        if self._links:
+            for link, _, F in self._links:
+                momentum.external_wrench(obs, ff.last_q, r, out=F,
+                                         frame=link, axes='link')
+            F = None
+        elif obs.model.tool_body is None:
+            F = None
+        else:
+            F = momentum.external_wrench(obs, ff.last_q, r,
+                                         out=self._wrench_out)
         before = self.contact.in_contact
         now = momentum.contact_step(obs, self.contact, r,
                                     self.state.allowance)
@@ -195,11 +257,13 @@ class NodeObserver:
         t.header.stamp = msg.header.stamp
         t.effort = r.tolist()
         self.torque_pub.publish(t)
-        w = self._wrench
-        w.header.stamp = msg.header.stamp
-        f, m = w.wrench.force, w.wrench.torque
-        f.x, f.y, f.z, m.x, m.y, m.z = F.tolist()
-        self.wrench_pub.publish(w)
+        wrenches = ([(self._wrench, F)] if F is not None else
+                    [(w, values) for _, w, values in self._links])
+        for w, values in wrenches:
+            w.header.stamp = msg.header.stamp
+            f, m = w.wrench.force, w.wrench.torque
+            f.x, f.y, f.z, m.x, m.y, m.z = values.tolist()
+            self.wrench_pub.publish(w)
         if now != before:
             self.contact_pub.publish(Bool(data=now))
             if now:

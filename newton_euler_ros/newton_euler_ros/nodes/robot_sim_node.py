@@ -50,7 +50,8 @@ Subscribes
     (geometry_msgs/WrenchStamped, when the scene's wrench comes from the
     topic)
 Publishes
-    joint_states (sensor_msgs/JointState, effort = applied torque),
+    joint_states (sensor_msgs/JointState, effort = applied torque; a
+    tree's mimic joints after the others, following their leaders),
     wrench (geometry_msgs/WrenchStamped, when the scene has a wrench),
     ~/start (std_msgs/Header, transient local)
 """
@@ -78,6 +79,8 @@ from ..parameters import load_specs
 from ..safety import effort_bounds, TorqueGuard
 from ..sim.scene import load_scene
 from ..sim.simulate import integrator_step, SceneDynamics
+
+PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -120,8 +123,7 @@ class RobotSimNode(SharedGraphNode):
         except NewtonEulerError as exc:
             raise ConfigurationError(f'scene: {exc}') from None
         scene = self.scene
-        self.payload = (p['payload.mass'], p['payload.com'],
-                        p['payload.inertia'])
+        self.payload = tuple(p[k] for k in PAYLOAD)
         try:
             self.dyn = self._plant(self.payload)
         except ValueError as exc:
@@ -181,6 +183,16 @@ class RobotSimNode(SharedGraphNode):
         self.add_on_set_parameters_callback(self._on_set_parameters)
         self._state = JointState()
         self._state.name = list(scene.model.joint_names)
+        # a tree's mimic joints are published too, as a driver does:
+        # multiplier x leader + offset, no effort of their own
+        model = scene.model
+        follow = [(name, model.independent.index(m[0]), m[1], m[2])
+                  for name, m in zip(model.moving_joints, model.mimic or ())
+                  if m is not None]
+        self._state.name += [f[0] for f in follow]
+        self._lead = np.array([f[1] for f in follow], dtype=np.intp)
+        self._mult = np.array([f[2] for f in follow])
+        self._offset = np.array([f[3] for f in follow])
         self._wrench = WrenchStamped()
         if scene.wrench is not None:
             self._wrench.header.frame_id = FRAME_IDS[scene.wrench.frame]
@@ -283,9 +295,18 @@ class RobotSimNode(SharedGraphNode):
         self._publish_wrench(stamp)     # first: the torques need it
         msg = self._state
         msg.header.stamp = stamp
-        msg.position = self.q.tolist()
-        msg.velocity = self.qd.tolist()
-        msg.effort = self.applied.tolist()
+        if self._lead.size:
+            lead = self._lead
+            msg.position = np.concatenate([
+                self.q, self._mult * self.q[lead] + self._offset]).tolist()
+            msg.velocity = np.concatenate([
+                self.qd, self._mult * self.qd[lead]]).tolist()
+            msg.effort = np.concatenate([
+                self.applied, np.zeros(lead.size)]).tolist()
+        else:
+            msg.position = self.q.tolist()
+            msg.velocity = self.qd.tolist()
+            msg.effort = self.applied.tolist()
         self.state_pub.publish(msg)
 
     def _guarded(self, tau):
@@ -300,7 +321,7 @@ class RobotSimNode(SharedGraphNode):
         return out
 
     def _plant(self, payload):
-        """Scene dynamics with a payload on the end effector."""
+        """Scene dynamics with a payload on the end effector (or a link)."""
         model = payload_model(self.scene.model, *payload)
         return SceneDynamics(dataclasses.replace(self.scene, model=model))
 
@@ -308,11 +329,10 @@ class RobotSimNode(SharedGraphNode):
         values, errors = check_parameters(params, self.specs)
         if errors:
             return SetParametersResult(successful=False, reason=errors)
-        keys = ('payload.mass', 'payload.com', 'payload.inertia')
-        if not any(k in values for k in keys):
+        if not any(k in values for k in PAYLOAD):
             return SetParametersResult(successful=True)
         payload = tuple(values.get(k, old)
-                        for k, old in zip(keys, self.payload))
+                        for k, old in zip(PAYLOAD, self.payload))
         try:
             dyn = self._plant(payload)
         except (ValueError, TypeError) as exc:

@@ -236,7 +236,7 @@ def _payload(block, model, w):
     """Return the model carrying the ``payload`` block's rigid body."""
     if not isinstance(block, dict):
         raise RobotFileError(f'{w}.payload: must give mass, com, inertia')
-    _check_keys(block, {'mass', 'com', 'inertia'}, f'{w}.payload')
+    _check_keys(block, {'mass', 'com', 'inertia', 'link'}, f'{w}.payload')
     mass = to_number(block.get('mass'), f'{w}.payload.mass')
     if mass < 0.0:
         raise RobotFileError(f'{w}.payload.mass: must be >= 0')
@@ -246,7 +246,13 @@ def _payload(block, model, w):
     if not principal_moments(inertia)[1]:
         raise RobotFileError(f'{w}.payload.inertia: must be positive '
                              f'semidefinite')
-    return with_payload(model, mass, com, inertia)
+    link = block.get('link')
+    if link is not None and not isinstance(link, str):
+        raise RobotFileError(f'{w}.payload.link: must be a link name')
+    try:
+        return with_payload(model, mass, com, inertia, link)
+    except ValueError as exc:       # no end effector, or no such link
+        raise RobotFileError(f'{w}.payload: {exc}') from None
 
 
 def _friction(block, n, w):
@@ -285,6 +291,10 @@ def _effects(eff, model, origin):
             raise RobotFileError(f'{w}.wrench: must give frame and one of '
                                  f'constant, schedule, source')
         wrench = _wrench(block, f'{w}.wrench')
+        if model.tool_body is None:
+            raise RobotFileError(
+                f'{w}.wrench: {model.name} is a tree with several tips: no '
+                f'end effector for the wrench to act at')
     friction_on, block = _flag_or_block(eff.get('friction'),
                                         f'{w}.friction')
     viscous, coulomb = (_friction(block, n, w) if friction_on

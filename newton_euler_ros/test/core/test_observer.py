@@ -408,3 +408,31 @@ def test_single_steps_match_the_recording_function(panda):
         F = external_wrench(obs2, Q[k], r)
         contact_step(obs2, contact, r)
     assert (r == out.residual[-1]).all() and (F == out.wrench[-1]).all()
+
+
+def test_wrench_at_each_end_effector_of_a_tree():
+    """Baxter: a push on one gripper is read there, not at the other."""
+    from newton_euler_tools.peers import example_robot_urdf, PinocchioTree
+    path = example_robot_urdf('baxter_description/urdf/baxter.urdf')
+    model = _quiet_load(path)
+    peer = PinocchioTree(path, model)
+    obs = MomentumObserver(model, damping=0.0)
+    q = np.random.default_rng(5).uniform(-1, 1, model.n)
+    F = np.array([3.0, -5.0, 12.0, 0.3, -0.6, 0.2])
+    links = ('left_gripper', 'right_gripper')
+    for axes in ('base', 'link'):
+        J = peer.terms(q, q, q, links)      # Pinocchio's Jacobians
+        r = J[f'J left_gripper {axes}'].T @ F
+        np.testing.assert_allclose(external_wrench(
+            obs, q, r, frame='left_gripper', axes=axes), F, atol=1e-9)
+        assert not external_wrench(obs, q, r, frame='right_gripper',
+                                   axes=axes).any()
+    with pytest.raises(DynamicsInputError, match='left_grip'):
+        external_wrench(obs, q, r, frame='left_grip')
+    # a chain: the end effector named is the default one
+    puma = _quiet_load('puma560')
+    chain = MomentumObserver(puma)
+    r = np.random.default_rng(6).uniform(-5, 5, 6)
+    np.testing.assert_array_equal(
+        external_wrench(chain, q[:6], r),
+        external_wrench(chain, q[:6], r, frame='end_effector'))

@@ -177,3 +177,38 @@ def test_cli_feedforward(tmp_path, puma):
     last = err.strip().splitlines()[-1]      # after the puma's warnings
     assert last.startswith('newton-euler: error: ') and \
         'traj.json: points[1].time_from_start' in last
+
+
+def test_a_trajectory_of_some_joints_of_a_tree_holds_the_others():
+    """The named joints move, the others stay at ``hold``, at rest."""
+    from newton_euler_ros.core import load_urdf, wrench_torques
+    from random_tree import random_tree_urdf
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        tree = load_urdf(random_tree_urdf(7, links=9)[0])
+    rng = np.random.default_rng(7)
+    hold = rng.uniform(-1, 1, tree.n)
+    # the joints of the deepest branch: their ancestors are held, and so
+    # change their torques
+    names = list(tree.joint_names[tree.n // 2:])[::-1]
+    named = [tree.joint_names.index(j) for j in names]
+    times = np.arange(4) * 0.1
+    Q, QD, QDD = rng.uniform(-1, 1, (3, 4, len(names)))
+    pts = [{'time_from_start': t, 'positions': q.tolist(),
+            'velocities': qd.tolist(), 'accelerations': qdd.tolist()}
+           for t, q, qd, qdd in zip(times, Q, QD, QDD)]
+    F = {'l03': np.array([1.0, -2.0, 3.0, 0.1, 0.2, 0.3])}   # a wrench
+    got = trajectory_efforts(tree, names, pts, F, 'base', hold=hold)
+    for k in range(4):
+        x, v, a = hold.copy(), np.zeros(tree.n), np.zeros(tree.n)
+        x[named], v[named], a[named] = Q[k], QD[k], QDD[k]
+        full = inverse_dynamics(tree, x, v, a) + wrench_torques(
+            tree, x, F, 'base')
+        np.testing.assert_allclose(got[k], full[named], rtol=1e-12,
+                                   atol=1e-12)
+        x0 = np.where(np.isin(np.arange(tree.n), named), x, 0.0)
+        other = inverse_dynamics(tree, x0, v, a) + wrench_torques(
+            tree, x0, F, 'base')      # held at zero instead: not the same
+        assert np.abs(other[named] - full[named]).max() > 1e-6
+    with pytest.raises(DynamicsInputError, match='missing joints'):
+        trajectory_efforts(tree, names, pts)

@@ -744,9 +744,14 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
     assert 'massless' not in out          # tool0 is a frame
     code, out, err = run_cli('check', str(path))     # the whole tree
     assert code == 0, err
-    assert ('tree below world: world -[mount]-> base_link, base_link -[j1]-> '
-            'l1, l1 -[j2]-> l2, l2 -[j3]-> l3, l3 -[flange]-> tool0, '
-            'l2 -[grip]-> finger') in out
+    # one joint a line, indented by depth, with its type
+    assert ('    world\n'
+            '      mount (fixed, merged) -> base_link\n'
+            '        j1 (revolute) -> l1\n'
+            '          j2 (prismatic) -> l2\n'
+            '            j3 (continuous) -> l3\n'
+            '              flange (fixed, merged) -> tool0\n'
+            '            grip (prismatic) -> finger\n') in out
     assert 'joints: 4 (RPRP)' in out
 
 

@@ -98,6 +98,7 @@ def test_names_are_relative_or_private(tmp_path, namespace, remap,
     ('closed_loop.launch.py', ('CONTROLLER_REMAPS',)),
     ('inverse_dynamics.launch.py', ('INVERSE_DYNAMICS_TOPICS',)),
     ('inverse_dynamics_urdf.launch.py', ('URDF_TOPICS',)),
+    ('whole_robot.launch.py', ('URDF_TOPICS',)),
 ])
 def test_launch_files_take_their_wiring_from_graph(launch_file, names):
     """The launch files' remaps come from graph.py, written once there."""
