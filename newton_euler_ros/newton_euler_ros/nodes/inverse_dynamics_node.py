@@ -60,15 +60,17 @@ from .common import (check_parameters, ConfigurationError,
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
+from ..core.text import clip
 from ..core.trajectory import trajectory_efforts
 from ..core.urdf import urdf_model
-from ..feedforward import (check_payload, clip, FeedforwardComputer,
-                           InputRejected, JointOrder, payload_model,
-                           ReferenceTrajectory, rigid_frames, WrenchInput)
+from ..feedforward import FeedforwardComputer
+from ..feedforward_build import check_payload, payload_model
+from ..joint_inputs import InputRejected, JointOrder, ReferenceTrajectory
 from ..parameters import load_specs
-from ..safety import effort_bounds, TorqueGuard, wrench_bounds
+from ..safety import effort_bounds, TorqueGuard
 from ..sim.scene import load_scene
-from ..whole_robot import followers_of, JointStateMerger, LinkWrenches
+from ..whole_robot import followers_of, JointStateMerger
+from ..wrenches import wrench_input
 
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
@@ -229,7 +231,7 @@ class InverseDynamicsNode(SharedGraphNode):
             override = model_order
         bounds, sources = effort_bounds(model, override)
         if wrench is None:
-            wrench = self._wrench_input(p, model, bounds, whole)
+            wrench = wrench_input(p, model, bounds, whole)
         ff = FeedforwardComputer.from_parameters(
             p, model, order, wrench, bounds, sources, reference, scene,
             self.mode, bare_model=bare,
@@ -321,17 +323,6 @@ class InverseDynamicsNode(SharedGraphNode):
         self._log_model(ff, self.model_source)
 
     # ---- parameters ----
-    def _wrench_input(self, p, model, bounds, whole):
-        if whole:
-            return LinkWrenches(model, p['wrench.base_frames'],
-                                p['wrench.end_effector_frames'],
-                                p['wrench.link'], p['wrench.convention'],
-                                p['wrench.timeout'], wrench_bounds(bounds))
-        return WrenchInput(p['wrench.base_frames'],
-                           p['wrench.end_effector_frames'],
-                           p['wrench.convention'], p['wrench.timeout'],
-                           rigid_frames(model), wrench_bounds(bounds))
-
     def _on_set_parameters(self, params):
         values, errors = check_parameters(params, self.specs)
         if errors:
@@ -345,9 +336,9 @@ class InverseDynamicsNode(SharedGraphNode):
         new_ff = None
         if ff is not None:
             try:
-                new_wrench = self._wrench_input(current, ff.model,
-                                                ff.guard.bounds,
-                                                ff.merger is not None)
+                new_wrench = wrench_input(current, ff.model,
+                                          ff.guard.bounds,
+                                          ff.merger is not None)
                 if payload != self.payload:
                     # a new model and workspace, built here, off the hot
                     # path; everything else carries over

@@ -42,7 +42,7 @@ from ..core import NewtonEulerError
 from ..core import observer as momentum
 from ..core.effects import friction_torque
 from ..core.text import clip
-from ..feedforward import InputRejected
+from ..joint_inputs import InputRejected
 
 
 def _seconds(stamp):

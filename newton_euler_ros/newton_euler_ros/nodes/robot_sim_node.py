@@ -74,7 +74,7 @@ from .common import (check_parameters, ConfigurationError,
                      SharedGraphNode)
 from ..core import NewtonEulerError
 from ..core.trajectory import TrajectoryFollower
-from ..feedforward import payload_model
+from ..feedforward_build import payload_model
 from ..parameters import load_specs
 from ..safety import effort_bounds, TorqueGuard
 from ..sim.scene import load_scene

@@ -23,10 +23,10 @@ import re
 import warnings
 
 from newton_euler_ros.core import inverse_dynamics, load_robot, mass_matrix
-from newton_euler_ros.feedforward import (APPLIED_TO_ROBOT,
-                                          FeedforwardComputer, InputRejected,
-                                          JointOrder, ReferenceTrajectory,
-                                          WrenchInput)
+from newton_euler_ros.feedforward import FeedforwardComputer
+from newton_euler_ros.joint_inputs import (InputRejected, JointOrder,
+                                           ReferenceTrajectory)
+from newton_euler_ros.wrenches import APPLIED_TO_ROBOT, WrenchInput
 import numpy as np
 import pytest
 

@@ -16,16 +16,18 @@
 A whole robot's inputs without ROS: partial joint states, sensors at links.
 
 On published URDFs (Baxter: two arms, a head, a mimic finger in each
-gripper; Unitree's Z1, a tree with a single tip): the rules
-of ``whole_robot`` one by one, and the wrenches the sensors give against
-sum J_link^T F from the Jacobians of the links.
+gripper; Unitree's Z1, a tree with a single tip): the rules of
+``whole_robot.JointStateMerger`` and ``wrenches.LinkWrenches`` one by
+one, and the wrenches the sensors give against sum J_link^T F from the
+Jacobians of the links.
 """
 import warnings
 
 from newton_euler_ros.core import (frame_pose, inverse_dynamics, jacobian,
                                    load_urdf)
-from newton_euler_ros.feedforward import InputRejected
-from newton_euler_ros.whole_robot import JointStateMerger, LinkWrenches
+from newton_euler_ros.joint_inputs import InputRejected
+from newton_euler_ros.whole_robot import JointStateMerger
+from newton_euler_ros.wrenches import LinkWrenches
 import numpy as np
 import pytest
 
