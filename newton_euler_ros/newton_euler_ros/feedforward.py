@@ -20,8 +20,9 @@ The node converts messages to plain Python/numpy values and calls into
 joint order (``joint_inputs``), the wrench input (``wrenches``), the
 reference and, on a whole robot, the joint-state merger
 (``whole_robot``): tau = D qdd + C qd + g + J^T F_e for a joint state,
-the terms for a service request.  The payload is merged into a model
-by ``feedforward_build``.  Everything here is testable without a ROS graph;
+the terms for a service request, the efforts of a planned trajectory.
+It is built for a node's parameters, payload included, by
+``feedforward_build``.  Everything here is testable without a ROS graph;
 every rejection raises ``InputRejected`` with a one-line reason and a
 short ``kind`` used for counters.
 """
@@ -30,9 +31,10 @@ import dataclasses
 import numpy as np
 
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
-                   inverse_dynamics, mass_matrix)
+                   inverse_dynamics, mass_matrix, NewtonEulerError)
 from .core.drives import model_drives
 from .core.effects import EffectDynamics, RIGID_BODY
+from .core.trajectory import trajectory_efforts
 from .joint_inputs import InputRejected
 from .safety import TorqueGuard, velocity_bounds
 from .wrenches import WrenchInput
@@ -257,3 +259,52 @@ class FeedforwardComputer:
             raise InputRejected('non_finite', 'dynamics produced a '
                                 'non-finite value')
         return out
+
+    def trajectory(self, names, points, now, include_wrench=True):
+        """
+        Guarded efforts of a planned trajectory, or InputRejected.
+
+        ``points`` are dicts of ``time_from_start``, ``positions``,
+        ``velocities``, ``accelerations``
+        (:func:`~newton_euler_ros.core.trajectory.trajectory_efforts`);
+        the wrench held at ``now`` acts along it with ``include_wrench``.
+        On a whole robot the joints it leaves out are held at the last
+        joint state, at rest.  Return (efforts, a row per point in the
+        order of ``names``, or None when the guard drops them; whether a
+        point exceeded the torque bounds).
+        """
+        w, frame = (self.wrench.current(now) if include_wrench
+                    else (None, 'base'))
+        hold = self._hold(names)
+        try:
+            efforts = trajectory_efforts(
+                self.model, names, points, w, frame, 'trajectory: ',
+                self.ws, drives=self.drives,
+                gravity=not self.robot_compensates_gravity, hold=hold)
+        except NewtonEulerError as exc:
+            raise InputRejected('malformed', str(exc)) from None
+        out = efforts.copy()
+        exceeded = False
+        # the bounds of the trajectory's joints, in its order
+        where = {name: k for k, name in enumerate(self.output_names)}
+        guard = TorqueGuard(self.guard.bounds[[where[name] for name in
+                                               names]],
+                            self.guard.action)
+        for k in range(out.shape[0]):
+            row, over = guard.check(efforts[k])
+            exceeded |= over
+            if row is None:
+                return None, True
+            out[k] = row
+        return out, exceeded
+
+    def _hold(self, names):
+        """Return where a whole robot's joints a trajectory leaves out are."""
+        if self.merger is None or set(self.model.joint_names) <= set(names):
+            return None
+        if self.last_q is None:
+            raise InputRejected(
+                'no_state', f'the trajectory names {len(names)} of the '
+                f'{self.model.n} joints, and no joint state has arrived '
+                f'yet to hold the others at')
+        return self.last_q

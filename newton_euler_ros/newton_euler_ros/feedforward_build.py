@@ -13,17 +13,30 @@
 # limitations under the License.
 
 """
-The payload of a node's model, free of ROS.
+A FeedforwardComputer for a model and a node's parameters, free of ROS.
 
-:func:`check_payload` checks a payload's values, :func:`payload_model`
-merges it into a model, off the hot path (start-up, a payload change).
+Everything the node builds off the hot path, at start-up, when a
+``robot_description`` arrives or when the payload changes: the payload
+merged into the model (:func:`payload_model`, checked by
+:func:`check_payload`), the joint order, the torque bounds, the wrench
+input, the reference and, on a whole robot (:func:`is_whole_robot`), the
+joint-state merger; then the computer, warm (:func:`build_computer`).
 """
+import dataclasses
 import math
 
 import numpy as np
 
 from .core.inertia import format_moments, inertia_matrix, principal_moments
 from .core.model import with_payload
+from .feedforward import FeedforwardComputer
+from .joint_inputs import JointOrder, ReferenceTrajectory
+from .safety import effort_bounds
+from .whole_robot import followers_of, JointStateMerger
+from .wrenches import wrench_input
+
+#: the payload's parameters, in the order of :func:`payload_model`
+PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
 
 
 def check_payload(mass, com, inertia6):
@@ -64,3 +77,64 @@ def payload_model(model, mass, com, inertia6, link=''):
     if mass == 0.0 and not inertia.any():
         return model
     return with_payload(model, mass, com, inertia, link or None)
+
+
+def is_whole_robot(model, tip_link=''):
+    """Say whether a model is a whole robot (a URDF tree, no tip link)."""
+    report = model.info.get('urdf') if isinstance(model.info, dict) \
+        else None
+    return bool(report and report.get('tree') and not tip_link)
+
+
+def build_computer(params, mode, model, payload, scene=None, previous=None):
+    """
+    Joint order, wrench input and a warm computer for a model.
+
+    ``params`` are a node's parameters, ``mode`` its torque mode,
+    ``payload`` the values of :data:`PAYLOAD`, merged into ``model`` (the
+    model without it, kept as ``ff.bare_model``).  With ``previous`` (same
+    joints) its joint order, wrench, reference and merger carry over, so a
+    payload change rebuilds only the model and its workspace.  Bad
+    settings raise ValueError.
+    """
+    p = params
+    bare = model
+    model = payload_model(bare, *payload)
+    if scene is not None:
+        scene = dataclasses.replace(scene, model=model)
+    whole = is_whole_robot(bare, p['tip_link']) and scene is None
+    if previous is not None:
+        order, wrench = previous.order, previous.wrench
+        reference = previous.reference
+    else:
+        order = JointOrder(model.joint_names, p['joints'] or None,
+                           p['limits.max_names'], subset=whole,
+                           followers=followers_of(model))
+        wrench = None
+        reference = (ReferenceTrajectory(order)
+                     if mode == 'full' else None)
+    # torque bounds: the parameter (output order), the robot's, or
+    # derived from the model (with its payload)
+    override = p['limits.effort']
+    if len(override) and len(override) != model.n:
+        raise ValueError(f'limits.effort: must have {model.n} values '
+                         f'(one per joint), got {len(override)}')
+    if len(override):
+        model_order = np.empty(model.n)
+        model_order[order.to_output] = override
+        override = model_order
+    bounds, sources = effort_bounds(model, override)
+    if wrench is None:
+        wrench = wrench_input(p, model, bounds, whole)
+    ff = FeedforwardComputer.from_parameters(
+        p, model, order, wrench, bounds, sources, reference, scene,
+        mode, bare_model=bare,
+        bare_scene=scene if previous is None else previous.bare_scene)
+    if previous is not None:
+        ff.merger = previous.merger
+    elif whole:
+        ff.merger = JointStateMerger(
+            model, order.output_joints[:order.command],
+            p['joint_states.hold'], p['joint_states.mimic_tolerance'],
+            p['limits.max_names'])
+    return ff
