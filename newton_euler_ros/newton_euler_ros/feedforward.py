@@ -283,6 +283,8 @@ class FeedforwardComputer:
                 gravity=not self.robot_compensates_gravity, hold=hold)
         except NewtonEulerError as exc:
             raise InputRejected('malformed', str(exc)) from None
+        if self.guard is None:
+            return efforts, False
         out = efforts.copy()
         exceeded = False
         # the bounds of the trajectory's joints, in its order

@@ -16,10 +16,12 @@
 inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
-result is published.  docs/node.md describes the whole interface.  With a
-URDF and no tip_link it serves the whole robot below base_link (a tree,
-mimic joints): joint states from several drivers merged, wrenches at the
-links their frames name (``whole_robot``; docs/node.md, "Whole robots").
+result is published (the ROS-free layer: ``feedforward``, built by
+``feedforward_build``; the reports: ``inverse_dynamics_reports``).
+docs/node.md describes the whole interface.  With a URDF and no tip_link
+it serves the whole robot below base_link (a tree, mimic joints): joint
+states from several drivers merged, wrenches at the links their frames
+name (``whole_robot``, ``wrenches``; docs/node.md, "Whole robots").
 
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
