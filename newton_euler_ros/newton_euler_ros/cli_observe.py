@@ -132,7 +132,7 @@ def _setup(args):
     """Model (payload included) and observer; _Usage on bad input."""
     from .core import inspect_robot, NewtonEulerError
     from .core.observer import drive_options, MomentumObserver
-    from .feedforward import payload_model
+    from .feedforward_build import payload_model
 
     for name in ('gain', 'max_gap'):
         _finite(f'--{name.replace("_", "-")}', getattr(args, name), 0.0)

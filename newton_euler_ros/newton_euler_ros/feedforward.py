@@ -13,406 +13,33 @@
 # limitations under the License.
 
 """
-Feedforward torque computation behind the ROS node, free of ROS.
+Feedforward torques for one message, free of ROS.
 
 The node converts messages to plain Python/numpy values and calls into
-this module; everything here is testable without a ROS graph:
-
-- :class:`JointOrder` maps named joint vectors (any order, extra joints)
-  onto the model's joint order and back to the output order.
-- :class:`WrenchInput` keeps the latest end-effector wrench with its frame,
-  sign convention and age.
-- :class:`ReferenceTrajectory` samples desired accelerations from a joint
-  trajectory.
-- :class:`FeedforwardComputer` ties them to the dynamics.
-
-Every rejection raises :class:`InputRejected` with a one-line reason and a
+:class:`FeedforwardComputer`, which holds the model, its workspace, the
+joint order (``joint_inputs``), the wrench input (``wrenches``), the
+reference and, on a whole robot, the joint-state merger
+(``whole_robot``): tau = D qdd + C qd + g + J^T F_e for a joint state,
+the terms for a service request, the efforts of a planned trajectory.
+It is built for a node's parameters, payload included, by
+``feedforward_build``.  Everything here is testable without a ROS graph;
+every rejection raises ``InputRejected`` with a one-line reason and a
 short ``kind`` used for counters.
 """
 import dataclasses
-import math
 
 import numpy as np
 
 from .core import (coriolis_matrix, DynamicsInputError, gravity_torques,
-                   inverse_dynamics, mass_matrix)
+                   inverse_dynamics, mass_matrix, NewtonEulerError)
 from .core.drives import model_drives
 from .core.effects import EffectDynamics, RIGID_BODY
-from .core.inertia import format_moments, inertia_matrix, principal_moments
-from .core.model import with_payload
-from .core.text import clip
+from .core.trajectory import trajectory_efforts
+from .joint_inputs import InputRejected
 from .safety import TorqueGuard, velocity_bounds
-
-EXERTED_BY_ROBOT = 'exerted_by_robot'
-APPLIED_TO_ROBOT = 'applied_to_robot'
-
-
-class InputRejected(Exception):
-    """An input message cannot be used; ``kind`` names the counter."""
-
-    def __init__(self, kind, message):
-        super().__init__(message)
-        self.kind = kind
-
-
-class JointOrder:
-    """
-    Map named joint values onto a model's joints, and out again.
-
-    Parameters
-    ----------
-    model_joints : names in the model's order (the dynamics' order).
-    output_joints : names in the order results are published, a
-        permutation of ``model_joints``; with ``subset`` some of them
-        (the commanded joints), the others following in model order.
-    followers : {mimic joint: (leader, ...)}: named in the output, one is
-        refused with its leader's name.
-
-    """
-
-    def __init__(self, model_joints, output_joints=None, max_names=0,
-                 subset=False, followers=None):
-        self.model_joints = tuple(model_joints)
-        #: longer name lists are rejected before any per-name work
-        self.max_names = max_names or 4 * len(self.model_joints) + 16
-        output = tuple(output_joints) if output_joints else self.model_joints
-        if len(set(output)) != len(output):
-            dup = next(j for j in output if output.count(j) > 1)
-            raise ValueError(f'joints: {dup!r} is listed twice')
-        mimic = [j for j in output if j in (followers or {})]
-        if mimic:
-            raise ValueError(f'joints: {mimic[0]!r} is a mimic joint (it '
-                             f'follows {followers[mimic[0]][0]!r}): its '
-                             f'torque acts through its leader')
-        missing = sorted(set(self.model_joints) - set(output))
-        extra = sorted(set(output) - set(self.model_joints))
-        if extra or (missing and not subset):
-            raise ValueError(
-                ('joints: must name every joint of the robot exactly once'
-                 if not subset else 'joints: must name joints of the robot')
-                + (f'; missing {missing}' if missing and not subset else '')
-                + (f'; not in the robot: {extra}' if extra else ''))
-        #: ~/torque_command carries the first ``command`` joints of the
-        #: output: those named (a subset on a whole robot), then the rest
-        self.command = len(output)
-        output += tuple(j for j in self.model_joints if j not in output)
-        self.output_joints = output
-        index = {name: i for i, name in enumerate(self.model_joints)}
-        #: out[k] = model_vector[self.to_output[k]]
-        self.to_output = np.array([index[j] for j in output], dtype=np.intp)
-        self._cache_names = None
-        self._cache_take = None
-        #: the last name list that held none of the model's joints
-        self._other_names = None
-
-    @property
-    def n(self):
-        return len(self.model_joints)
-
-    def _take(self, names):
-        """
-        Return the indices into a message's arrays that give the model's order.
-
-        A message that names none of the model's joints (another
-        publisher's on the same topic, e.g. a gripper driver's) raises
-        InputRejected of kind ``other_joints``.
-        """
-        if names == self._cache_names:
-            return self._cache_take
-        if names == self._other_names:
-            raise self._other_joints(names)
-        where = {}
-        for i, name in enumerate(names):
-            if not name.isprintable():
-                raise InputRejected('malformed',
-                                    f'joint name {clip(name, 60)!r} has '
-                                    f'control characters')
-            if name in where:
-                raise InputRejected('malformed',
-                                    f'joint {clip(name, 60)!r} appears '
-                                    f'twice')
-            where[name] = i
-        missing = [j for j in self.model_joints if j not in where]
-        if names and len(missing) == len(self.model_joints):
-            self._other_names = list(names)
-            raise self._other_joints(names)
-        if missing:
-            # all of them, and what the message does name
-            raise InputRejected(
-                'missing_joints', f'missing joints {clip(missing, 600)}; '
-                f'the message names {len(names)}: '
-                f'{clip([clip(x, 60) for x in names], 600)}')
-        take = np.array([where[j] for j in self.model_joints], dtype=np.intp)
-        self._cache_names = list(names)
-        self._cache_take = take
-        return take
-
-    def _other_joints(self, names):
-        return InputRejected(
-            'other_joints', f"none of the robot's joints (it names "
-            f'{clip([clip(x, 60) for x in names[:8]], 300)})')
-
-    def gather(self, names, field, values, required=True):
-        """
-        Model-ordered float64 vector of one field (position, ...).
-
-        An empty ``values`` gives None when not ``required``.
-        """
-        if len(names) > self.max_names or len(values) > self.max_names:
-            raise InputRejected(
-                'oversized', f'{max(len(names), len(values))} names or '
-                f'values, more than the {self.max_names} accepted')
-        names = list(names)
-        if len(values) == 0 and not required:
-            return None
-        if len(values) != len(names):
-            raise InputRejected(
-                'malformed', f'{field} has {len(values)} entries for '
-                f'{len(names)} names')
-        take = self._take(names)
-        x = np.asarray(values, dtype=np.float64)[take]
-        if not np.isfinite(x).all():
-            k = int(np.argmin(np.isfinite(x)))
-            raise InputRejected(
-                'non_finite', f'{field} of {self.model_joints[k]!r} is '
-                f'{float(x[k])!r}')
-        return x
-
-    def to_output_order(self, x):
-        return x[self.to_output]
-
-    def matrix_to_output_order(self, M):
-        return M[np.ix_(self.to_output, self.to_output)]
-
-
-class WrenchInput:
-    """
-    The latest end-effector wrench, as the dynamics expect it.
-
-    Parameters
-    ----------
-    base_frames, end_effector_frames : ``header.frame_id`` values taken as
-        base-frame or end-effector-frame axes.
-    convention : ``'exerted_by_robot'`` (the library's F_e) or
-        ``'applied_to_robot'`` (what a wrist force/torque sensor reports:
-        the wrench the environment applies; it is negated).
-    timeout : seconds after which a wrench is stale (0 disables).
-    rigid_frames : optional ``{frame_id: (kind, T)}`` of frames rigidly
-        attached to the base (``kind`` ``'base'``) or to the end effector
-        (``'end_effector'``), with T the 4x4 pose of the frame in that one
-        (from a URDF).  A wrench in such a frame (moment about its origin)
-        is rotated into base or end-effector axes, and an end-effector
-        one also moved to the end-effector origin: n_ee = R n + p x R f.
-        A frame listed in ``base_frames`` / ``end_effector_frames`` uses
-        its transform when it is attached to that same side.
-
-    """
-
-    def __init__(self, base_frames, end_effector_frames,
-                 convention=EXERTED_BY_ROBOT, timeout=0.5, rigid_frames=None,
-                 bounds=(np.inf, np.inf)):
-        both = set(base_frames) & set(end_effector_frames)
-        if both:
-            raise ValueError(f'frame {sorted(both)[0]!r} is listed as both a '
-                             f'base and an end-effector frame')
-        if convention not in (EXERTED_BY_ROBOT, APPLIED_TO_ROBOT):
-            raise ValueError(f"wrench convention must be '{EXERTED_BY_ROBOT}'"
-                             f" or '{APPLIED_TO_ROBOT}', got {convention!r}")
-        if not (timeout >= 0.0 and math.isfinite(timeout)):
-            raise ValueError(f'wrench timeout must be >= 0 s, got {timeout}')
-        self.frames = dict.fromkeys(base_frames, 'base')
-        self.frames.update(dict.fromkeys(end_effector_frames, 'end_effector'))
-        self.transforms = {}
-        for frame_id, (kind, T) in (rigid_frames or {}).items():
-            if self.frames.setdefault(frame_id, kind) != kind:
-                continue        # listed for the other side: taken as axes
-            T = np.asarray(T, dtype=np.float64)
-            if np.array_equal(T, np.eye(4)):
-                continue
-            self.transforms[frame_id] = (T[:3, :3].copy(), T[:3, 3].copy())
-        self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
-        self.max_force, self.max_moment = bounds
-        self.timeout = timeout
-        self.wrench = None
-        self.frame = 'base'
-        self.stamp = None
-        self.expired = 0
-
-    def update(self, frame_id, values, stamp, now):
-        """Accept a wrench [fx, fy, fz, tx, ty, tz] stamped ``stamp`` (s)."""
-        frame = self.frames.get(frame_id)
-        if frame is None:
-            raise InputRejected(
-                'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} '
-                f'is not one of {clip(sorted(self.frames), 200)}')
-        w = np.asarray(values, dtype=np.float64)
-        if not np.isfinite(w).all():
-            raise InputRejected('non_finite', f'wrench has a non-finite '
-                                f'entry: {w.tolist()}')
-        # component-wise (a norm of 1e200 would overflow)
-        force, moment = np.abs(w[:3]).max(), np.abs(w[3:]).max()
-        if force > self.max_force or moment > self.max_moment:
-            raise InputRejected(
-                'implausible', f'wrench with a force of {force:.4g} N or a '
-                f'moment of {moment:.4g} N m along an axis is beyond the '
-                f'plausible {self.max_force:.4g} N, {self.max_moment:.4g} '
-                f'N m')
-        if stamp == 0.0:          # unstamped: take it as of now
-            stamp = now
-        if self.timeout and now - stamp > self.timeout:
-            raise InputRejected(
-                'stale', f'wrench is {now - stamp:.3f} s old (timeout '
-                f'{self.timeout} s)')
-        if self.timeout and stamp - now > self.timeout:
-            # a clock running ahead would otherwise keep it applied forever
-            raise InputRejected(
-                'stale', f'wrench is stamped {stamp - now:.3f} s in the '
-                f'future (timeout {self.timeout} s)')
-        moved = self.transforms.get(frame_id)
-        if moved is not None:
-            R, p = moved
-            f = R @ w[:3]
-            n = R @ w[3:]
-            if frame == 'end_effector':
-                n = n + np.cross(p, f)
-            w = np.concatenate([f, n])
-        self.wrench = self.sign * w
-        self.frame = frame
-        self.stamp = stamp
-
-    def current(self, now):
-        """
-        (wrench or None, frame) at ``now``; reading changes nothing.
-
-        A wrench older than the timeout is not returned (the torques are
-        then computed without it); :meth:`expire` drops and counts it.
-        """
-        if self.wrench is None or self._too_old(now):
-            return None, self.frame
-        return self.wrench, self.frame
-
-    def expire(self, now):
-        """
-        Drop the wrench if it is older than the timeout at ``now``.
-
-        Return True when it expired by this call (``expired`` counts each
-        such event once), False otherwise.
-        """
-        if self.wrench is None or not self._too_old(now):
-            return False
-        self.wrench = None
-        self.expired += 1
-        return True
-
-    def _too_old(self, now):
-        return bool(self.timeout) and now - self.stamp > self.timeout
-
+from .wrenches import WrenchInput
 
 MODES = ('gravity', 'gravity_coriolis', 'full')
-
-
-def check_payload(mass, com, inertia6):
-    """
-    Validate payload values; return (mass, com, 3x3 inertia) or ValueError.
-
-    ``inertia6`` is [Ixx, Iyy, Izz, Ixy, Iyz, Ixz] about the payload's
-    centre of mass ``com`` (end-effector frame).
-    """
-    mass = float(mass)
-    com = np.asarray(com, dtype=np.float64).reshape(-1)
-    values = np.asarray(inertia6, dtype=np.float64).reshape(-1)
-    if not (mass >= 0.0 and math.isfinite(mass)):
-        raise ValueError(f'payload.mass: must be >= 0 and finite, got {mass}')
-    if com.shape != (3,) or not np.isfinite(com).all():
-        raise ValueError(f'payload.com: must be 3 finite numbers, got '
-                         f'{com.tolist()}')
-    if values.shape != (6,) or not np.isfinite(values).all():
-        raise ValueError(f'payload.inertia: must be 6 finite numbers, got '
-                         f'{values.tolist()}')
-    inertia = inertia_matrix(*values)
-    eig, valid = principal_moments(inertia)
-    if not valid:
-        raise ValueError(f'payload.inertia: not positive semi-definite '
-                         f'(principal moments {format_moments(eig)})')
-    return mass, com, inertia
-
-
-def payload_model(model, mass, com, inertia6, link=''):
-    """
-    Return the model with a payload on the end effector, or ValueError.
-
-    Merged into the last link (or the body carrying ``link``, a link of a
-    URDF model) by :func:`~newton_euler_ros.core.model.with_payload`, the
-    scenes' code; no payload (all zeros) returns ``model`` itself.
-    """
-    mass, com, inertia = check_payload(mass, com, inertia6)
-    if mass == 0.0 and not inertia.any():
-        return model
-    return with_payload(model, mass, com, inertia, link or None)
-
-
-def rigid_frames(model):
-    """
-    Frames rigidly attached to a URDF model's base or tip, for wrenches.
-
-    Returns ``{link: (kind, T)}`` for :class:`WrenchInput` (empty for a DH
-    model): every link fixed to the end effector (T its pose in the
-    end-effector frame) and to the base (T its pose in the base frame).
-    """
-    report = model.info.get('urdf') or {}
-    out = {name: ('base', T)
-           for name, T in report.get('base_frames', {}).items()}
-    out.update((name, ('end_effector', T))
-               for name, T in report.get('tip_frames', {}).items())
-    return out
-
-
-class ReferenceTrajectory:
-    """
-    Desired joint accelerations sampled from a joint trajectory.
-
-    Accelerations are interpolated linearly in time between points; before
-    the first point the first is used, after the last the last.  Points
-    without accelerations count as zero.
-    """
-
-    def __init__(self, order):
-        self.order = order
-        self.times = None
-        self.accelerations = None
-        self.start = 0.0
-
-    def set(self, names, start, points, now):  # noqa: A003 (public API name)
-        """``points``: list of (time_from_start s, accelerations list)."""
-        if not points:
-            self.times = None
-            return
-        times = np.array([p[0] for p in points], dtype=np.float64)
-        if not np.isfinite(times).all() or np.any(np.diff(times) < 0.0):
-            raise InputRejected('malformed', 'reference trajectory times '
-                                'must be finite and non-decreasing')
-        acc = np.zeros((len(points), self.order.n))
-        for k, (_, values) in enumerate(points):
-            if len(values):
-                acc[k] = self.order.gather(names, f'point {k} accelerations',
-                                           values)
-        self.times = times
-        self.accelerations = acc
-        self.start = now if start == 0.0 else start
-
-    def acceleration(self, t):
-        if self.times is None:
-            return None
-        s = t - self.start
-        times, acc = self.times, self.accelerations
-        if s <= times[0]:
-            return acc[0].copy()
-        if s >= times[-1]:
-            return acc[-1].copy()
-        k = int(np.searchsorted(times, s, side='right'))
-        t0, t1 = times[k - 1], times[k]
-        w = (s - t0) / (t1 - t0) if t1 > t0 else 1.0
-        return (1.0 - w) * acc[k - 1] + w * acc[k]
 
 
 class FeedforwardComputer:
@@ -632,3 +259,54 @@ class FeedforwardComputer:
             raise InputRejected('non_finite', 'dynamics produced a '
                                 'non-finite value')
         return out
+
+    def trajectory(self, names, points, now, include_wrench=True):
+        """
+        Guarded efforts of a planned trajectory, or InputRejected.
+
+        ``points`` are dicts of ``time_from_start``, ``positions``,
+        ``velocities``, ``accelerations``
+        (:func:`~newton_euler_ros.core.trajectory.trajectory_efforts`);
+        the wrench held at ``now`` acts along it with ``include_wrench``.
+        On a whole robot the joints it leaves out are held at the last
+        joint state, at rest.  Return (efforts, a row per point in the
+        order of ``names``, or None when the guard drops them; whether a
+        point exceeded the torque bounds).
+        """
+        w, frame = (self.wrench.current(now) if include_wrench
+                    else (None, 'base'))
+        hold = self._hold(names)
+        try:
+            efforts = trajectory_efforts(
+                self.model, names, points, w, frame, 'trajectory: ',
+                self.ws, drives=self.drives,
+                gravity=not self.robot_compensates_gravity, hold=hold)
+        except NewtonEulerError as exc:
+            raise InputRejected('malformed', str(exc)) from None
+        if self.guard is None:
+            return efforts, False
+        out = efforts.copy()
+        exceeded = False
+        # the bounds of the trajectory's joints, in its order
+        where = {name: k for k, name in enumerate(self.output_names)}
+        guard = TorqueGuard(self.guard.bounds[[where[name] for name in
+                                               names]],
+                            self.guard.action)
+        for k in range(out.shape[0]):
+            row, over = guard.check(efforts[k])
+            exceeded |= over
+            if row is None:
+                return None, True
+            out[k] = row
+        return out, exceeded
+
+    def _hold(self, names):
+        """Return where a whole robot's joints a trajectory leaves out are."""
+        if self.merger is None or set(self.model.joint_names) <= set(names):
+            return None
+        if self.last_q is None:
+            raise InputRejected(
+                'no_state', f'the trajectory names {len(names)} of the '
+                f'{self.model.n} joints, and no joint state has arrived '
+                f'yet to hold the others at')
+        return self.last_q

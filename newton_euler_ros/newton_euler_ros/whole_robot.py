@@ -13,33 +13,26 @@
 # limitations under the License.
 
 """
-The inputs of a whole robot (a URDF tree, no tip link), free of ROS.
+A whole robot's joint state from several drivers, free of ROS.
 
-On a dual-arm robot or an arm with its gripper, ``/joint_states`` is
-often published by several drivers, each naming part of the joints (an
-arm driver, a gripper driver), and wrenches come from several sensors (a
-force-torque sensor at each wrist).
+On a dual-arm robot or an arm with its gripper (a URDF tree, no tip
+link), ``/joint_states`` is often published by several drivers, each
+naming part of the joints (an arm driver, a gripper driver).
+:class:`JointStateMerger` keeps the latest value of every joint and turns
+a partial JointState into the whole robot's state: a message is computed
+when it names at least one of the *trigger* joints (the ones commanded on
+``~/torque_command``), with every joint it does not name taken from the
+latest message that did, if that arrived within ``hold`` seconds; mimic
+followers it names are checked against their leaders.  (The wrenches of
+several sensors at links: ``wrenches.LinkWrenches``.)
 
-- :class:`JointStateMerger` keeps the latest value of every joint and
-  turns a partial JointState into the whole robot's state: a message is
-  computed when it names at least one of the *trigger* joints (the ones
-  commanded on ``~/torque_command``), with every joint it does not name
-  taken from the latest message that did, if that arrived within
-  ``hold`` seconds; mimic followers it names are checked against their
-  leaders.
-- :class:`LinkWrenches` holds the last wrench of each sensor (told apart
-  by ``header.frame_id``), each with its own expiry, acting at the link
-  its frame names.
-
-Every rejection raises :class:`~newton_euler_ros.feedforward.InputRejected`
+Every rejection raises :class:`~newton_euler_ros.joint_inputs.InputRejected`
 with a one-line reason and the counter's ``kind``.
 """
-import math
-
 import numpy as np
 
 from .core.text import clip
-from .feedforward import APPLIED_TO_ROBOT, EXERTED_BY_ROBOT, InputRejected
+from .joint_inputs import InputRejected, name_positions, other_joints
 
 #: name lists remembered (each driver publishes its own, over and over)
 CACHED_NAME_LISTS = 8
@@ -59,16 +52,7 @@ class _Names:
     """Where a name list's joints go: coordinates, followers, the rest."""
 
     def __init__(self, names, index, followers):
-        where = {}
-        for i, name in enumerate(names):
-            if not name.isprintable():
-                raise InputRejected('malformed', f'joint name '
-                                    f'{clip(name, 60)!r} has control '
-                                    f'characters')
-            if name in where:
-                raise InputRejected('malformed', f'joint {clip(name, 60)!r}'
-                                    f' appears twice')
-            where[name] = i
+        where = name_positions(names)
         own = [(i, index[name]) for name, i in where.items() if name in index]
         #: message index and coordinate of each joint of the model named
         self.take = np.array([i for i, _ in own], dtype=np.intp)
@@ -161,9 +145,7 @@ class JointStateMerger:
                 f'names or values, more than the {self.max_names} accepted')
         where = self._names(names)
         if not where.take.size and not where.mimic:
-            raise InputRejected(
-                'other_joints', f"none of the robot's joints (it names "
-                f'{clip([clip(x, 60) for x in list(names)[:8]], 300)})')
+            raise other_joints(names)
         q = self._values('position', position, count, True)
         qd = self._values('velocity', velocity, count, False)
         eff = self._values('effort', effort, count, False)
@@ -246,135 +228,3 @@ class JointStateMerger:
             'missing_joints', f'missing joints ({"; ".join(parts)}); the '
             f'message names {len(names)}: '
             f'{clip([clip(x, 60) for x in names], 400)}')
-
-
-class LinkWrenches:
-    """
-    The last wrench of each sensor, at the link its frame names.
-
-    A ``WrenchStamped`` whose ``frame_id`` names a link of the model acts
-    at that link, in its axes, the moment about its origin (a force-torque
-    sensor's own frame).  A frame_id of ``base_frames`` is in base axes,
-    one of ``end_effector_frames`` in the axes of the link it acts at;
-    both act at ``link``, or the end effector when ``link`` is empty (a
-    tree with several tips has none: they are then unknown frames, even
-    one that is a link: the lists come first).
-    Sensors are told apart by frame_id; each one's last wrench applies
-    until it is older than ``timeout`` (0: forever).
-
-    ``current(now)`` returns the wrenches the dynamics take,
-    ``({frame: [f; n]}, {frame: 'base' | 'link'})``, or ``(None, 'base')``.
-    """
-
-    def __init__(self, model, base_frames, end_effector_frames, link='',
-                 convention=EXERTED_BY_ROBOT, timeout=0.5,
-                 bounds=(np.inf, np.inf)):
-        both = set(base_frames) & set(end_effector_frames)
-        if both:
-            raise ValueError(f'frame {sorted(both)[0]!r} is listed as both a '
-                             f'base and an end-effector frame')
-        if convention not in (EXERTED_BY_ROBOT, APPLIED_TO_ROBOT):
-            raise ValueError(f"wrench convention must be '{EXERTED_BY_ROBOT}'"
-                             f" or '{APPLIED_TO_ROBOT}', got {convention!r}")
-        if not (timeout >= 0.0 and math.isfinite(timeout)):
-            raise ValueError(f'wrench timeout must be >= 0 s, got {timeout}')
-        links = model.link_frames or {}
-        if link and link not in links:
-            raise ValueError(f'wrench.link: {link!r} is not a link of '
-                             f'{model.name}')
-        self.links = links
-        self.at = link or ('end_effector' if model.tool_body is not None
-                           else None)
-        self.base_frames = tuple(base_frames)
-        self.end_effector_frames = tuple(end_effector_frames)
-        self.sign = 1.0 if convention == EXERTED_BY_ROBOT else -1.0
-        self.max_force, self.max_moment = bounds
-        self.timeout = timeout
-        #: frame_id -> (target frame, axes, wrench, stamp)
-        self.held = {}
-        self.expired = 0
-        self.last_expired = []
-
-    @property
-    def frames(self):
-        """Return what a frame_id may be (for the log): the lists, any link."""
-        return ([*self.base_frames, *self.end_effector_frames]
-                if self.at is not None else []) + ['<any link>']
-
-    def target(self, frame_id):
-        """Return (frame the wrench acts at, axes) of a frame_id."""
-        listed = (frame_id in self.base_frames
-                  or frame_id in self.end_effector_frames)
-        if listed and self.at is not None:
-            return self.at, ('base' if frame_id in self.base_frames
-                             else 'link')
-        if listed:
-            raise InputRejected(
-                'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} '
-                f'of wrench.base_frames or end_effector_frames needs '
-                f'wrench.link to act at: the robot has several tips')
-        if frame_id in self.links:
-            return frame_id, 'link'
-        raise InputRejected(
-            'unknown_frame', f'wrench frame_id {clip(frame_id, 80)!r} is '
-            f'not a link of the robot nor one of wrench.base_frames, '
-            f'end_effector_frames')
-
-    def update(self, frame_id, values, stamp, now):
-        """Accept a sensor's wrench [fx, fy, fz, tx, ty, tz] stamped ``stamp``."""
-        at, axes = self.target(frame_id)
-        w = np.asarray(values, dtype=np.float64)
-        if not np.isfinite(w).all():
-            raise InputRejected('non_finite', f'wrench has a non-finite '
-                                f'entry: {w.tolist()}')
-        force, moment = np.abs(w[:3]).max(), np.abs(w[3:]).max()
-        if force > self.max_force or moment > self.max_moment:
-            raise InputRejected(
-                'implausible', f'wrench with a force of {force:.4g} N or a '
-                f'moment of {moment:.4g} N m along an axis is beyond the '
-                f'plausible {self.max_force:.4g} N, {self.max_moment:.4g} '
-                f'N m')
-        if stamp == 0.0:          # unstamped: take it as of now
-            stamp = now
-        if self.timeout and abs(now - stamp) > self.timeout:
-            ahead = stamp > now
-            raise InputRejected(
-                'stale', f'wrench in {clip(frame_id, 80)!r} is '
-                + (f'stamped {stamp - now:.3f} s in the future' if ahead
-                   else f'{now - stamp:.3f} s old')
-                + f' (timeout {self.timeout} s)')
-        for other, (o_at, o_axes, _, o_stamp) in self.held.items():
-            if self.timeout and now - o_stamp > self.timeout:
-                continue            # expired: no longer applies
-            if other != frame_id and o_at == at and o_axes != axes:
-                raise InputRejected(
-                    'malformed', f'wrench in {clip(frame_id, 80)!r} acts at '
-                    f'{at!r} in {axes} axes, where the one in {other!r} '
-                    f'acts in {o_axes} axes: one sensor per link')
-        self.held[frame_id] = (at, axes, self.sign * w, stamp)
-
-    def current(self, now):
-        """({frame: wrench}, {frame: axes}) of the unexpired wrenches."""
-        wrenches, axes = {}, {}
-        for at, frame, w, stamp in self.held.values():
-            if self.timeout and now - stamp > self.timeout:
-                continue
-            if at in wrenches:          # two sensors on one link: the sum
-                wrenches[at] = wrenches[at] + w
-            else:
-                wrenches[at], axes[at] = w, frame
-        if not wrenches:
-            return None, 'base'
-        return wrenches, axes
-
-    def expire(self, now):
-        """Drop the wrenches older than the timeout; True if any was."""
-        if not self.timeout:
-            return False
-        old = [k for k, (_, _, _, stamp) in self.held.items()
-               if now - stamp > self.timeout]
-        for k in old:
-            del self.held[k]
-        self.expired += len(old)
-        self.last_expired = old
-        return bool(old)

@@ -112,6 +112,11 @@ def declare_parameter(node, name, default, descriptor):
             f'{hint}') from None
 
 
+def seconds(stamp):
+    """Return a message's time (builtin_interfaces Time, Duration) in s."""
+    return stamp.sec + stamp.nanosec * 1e-9
+
+
 def plain(value):
     """Return a parameter value with arrays (tuple, array.array) as lists."""
     if isinstance(value, (tuple, list, array.array)):

@@ -16,10 +16,12 @@
 inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
-result is published.  docs/node.md describes the whole interface.  With a
-URDF and no tip_link it serves the whole robot below base_link (a tree,
-mimic joints): joint states from several drivers merged, wrenches at the
-links their frames name (``whole_robot``; docs/node.md, "Whole robots").
+result is published (the ROS-free layer: ``feedforward``, built by
+``feedforward_build``; the reports: ``inverse_dynamics_reports``).
+docs/node.md describes the whole interface.  With a URDF and no tip_link
+it serves the whole robot below base_link (a tree, mimic joints): joint
+states from several drivers merged, wrenches at the links their frames
+name (``whole_robot``, ``wrenches``; docs/node.md, "Whole robots").
 
 Subscribes
     joint_states (sensor_msgs/JointState), wrench (geometry_msgs/
@@ -39,15 +41,13 @@ Publishes
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
-import dataclasses
 import sys
 import threading
 import time
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
 from newton_euler_interfaces.srv import ComputeDynamics
-import numpy as np
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -56,19 +56,20 @@ from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
                      declare_parameters, qos_profile, QUIET,
-                     release_memory, run_node, SharedGraphNode)
+                     release_memory, run_node, seconds, SharedGraphNode)
+from .inverse_dynamics_reports import (answer, diagnostics, failed,
+                                       model_line, no_model_text)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
-from ..core.trajectory import trajectory_efforts
+from ..core.text import clip
 from ..core.urdf import urdf_model
-from ..feedforward import (check_payload, clip, FeedforwardComputer,
-                           InputRejected, JointOrder, payload_model,
-                           ReferenceTrajectory, rigid_frames, WrenchInput)
+from ..feedforward_build import (build_computer, check_payload,
+                                 is_whole_robot, PAYLOAD)
+from ..joint_inputs import InputRejected
 from ..parameters import load_specs
-from ..safety import effort_bounds, TorqueGuard, wrench_bounds
 from ..sim.scene import load_scene
-from ..whole_robot import followers_of, JointStateMerger, LinkWrenches
+from ..wrenches import wrench_input
 
 COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
             'unknown_frame', 'stale', 'expired', 'no_state',
@@ -81,13 +82,6 @@ COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-
-
-PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
-
-
-def _seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 class InverseDynamicsNode(SharedGraphNode):
@@ -193,88 +187,17 @@ class InverseDynamicsNode(SharedGraphNode):
 
     def _make_computer(self, model, scene=None, previous=None,
                        payload=None):
-        """
-        Joint order, wrench input and a warm computer for a model.
-
-        The run-time payload is merged into ``model`` (the model without
-        it, kept as ``ff.bare_model``).  With ``previous`` (same joints)
-        its joint order, wrench and reference carry over, so a payload
-        change rebuilds only the model and its workspace.
-        """
-        p = self.params
-        bare = model
-        model = payload_model(bare, *(payload or self.payload))
-        if scene is not None:
-            scene = dataclasses.replace(scene, model=model)
-        whole = self._whole(bare) and scene is None
-        if previous is not None:
-            order, wrench = previous.order, previous.wrench
-            reference = previous.reference
-        else:
-            order = JointOrder(model.joint_names, p['joints'] or None,
-                               p['limits.max_names'], subset=whole,
-                               followers=followers_of(model))
-            wrench = None
-            reference = (ReferenceTrajectory(order)
-                         if self.mode == 'full' else None)
-        # torque bounds: the parameter (output order), the robot's, or
-        # derived from the model (with its payload)
-        override = p['limits.effort']
-        if len(override) and len(override) != model.n:
-            raise ValueError(f'limits.effort: must have {model.n} values '
-                             f'(one per joint), got {len(override)}')
-        if len(override):
-            model_order = np.empty(model.n)
-            model_order[order.to_output] = override
-            override = model_order
-        bounds, sources = effort_bounds(model, override)
-        if wrench is None:
-            wrench = self._wrench_input(p, model, bounds, whole)
-        ff = FeedforwardComputer.from_parameters(
-            p, model, order, wrench, bounds, sources, reference, scene,
-            self.mode, bare_model=bare,
-            bare_scene=scene if previous is None else previous.bare_scene)
-        if previous is not None:
-            ff.merger = previous.merger
-        elif whole:
-            ff.merger = JointStateMerger(
-                model, order.output_joints[:order.command],
-                p['joint_states.hold'], p['joint_states.mimic_tolerance'],
-                p['limits.max_names'])
-        return ff
+        """Build the computer of a model (``build_computer``); ValueError."""
+        return build_computer(self.params, self.mode, model,
+                              payload or self.payload, scene, previous)
 
     def _whole(self, model):
         """Say whether a model is a whole robot (a URDF tree, no tip link)."""
-        report = model.info.get('urdf') if isinstance(model.info, dict) \
-            else None
-        return bool(report and report.get('tree')
-                    and not self.params['tip_link'])
+        return is_whole_robot(model, self.params['tip_link'])
 
     def _log_model(self, ff, source):
-        model = ff.model
-        effects = (ff.scene.effects.names() if ff.scene is not None
-                   else 'all rigid-body')
-        whole = ''
-        if ff.merger is not None:
-            mimic = [f'{f} follows {lead}' for f, (lead, _, _) in
-                     ff.merger.followers.items()]
-            whole = (f'whole robot, {model.nb} moving joints'
-                     + (f' ({clip(", ".join(mimic), 300)})' if mimic else '')
-                     + f', commanding {ff.order.command} on torque_command;'
-                     f' joints held {self.params["joint_states.hold"]} s; ')
-        self.get_logger().info(
-            f'{model.name} ({source}): {model.n} joints '
-            f'[{clip(", ".join(ff.output_names), 600)}], {whole}mode '
-            f'{self.mode}, effects '
-            f'{effects}, payload {self.payload[0]} kg, wrench frames '
-            f'{clip(str(sorted(ff.wrench.frames)), 400)}'
-            + ('' if not self.params['drives.compensate'] else
-               ', drive terms compensated' if ff.drives is not None else
-               ', drives.compensate is on but the robot has no drive '
-               'terms')
-            + (', without g(q): the robot adds it '
-               '(robot_compensates_gravity)'
-               if ff.robot_compensates_gravity else ''))
+        self.get_logger().info(model_line(ff, source, self.mode,
+                                          self.payload, self.params))
 
     # ---- robot_description ----
     def _on_description(self, msg):
@@ -321,17 +244,6 @@ class InverseDynamicsNode(SharedGraphNode):
         self._log_model(ff, self.model_source)
 
     # ---- parameters ----
-    def _wrench_input(self, p, model, bounds, whole):
-        if whole:
-            return LinkWrenches(model, p['wrench.base_frames'],
-                                p['wrench.end_effector_frames'],
-                                p['wrench.link'], p['wrench.convention'],
-                                p['wrench.timeout'], wrench_bounds(bounds))
-        return WrenchInput(p['wrench.base_frames'],
-                           p['wrench.end_effector_frames'],
-                           p['wrench.convention'], p['wrench.timeout'],
-                           rigid_frames(model), wrench_bounds(bounds))
-
     def _on_set_parameters(self, params):
         values, errors = check_parameters(params, self.specs)
         if errors:
@@ -345,9 +257,9 @@ class InverseDynamicsNode(SharedGraphNode):
         new_ff = None
         if ff is not None:
             try:
-                new_wrench = self._wrench_input(current, ff.model,
-                                                ff.guard.bounds,
-                                                ff.merger is not None)
+                new_wrench = wrench_input(current, ff.model,
+                                          ff.guard.bounds,
+                                          ff.merger is not None)
                 if payload != self.payload:
                     # a new model and workspace, built here, off the hot
                     # path; everything else carries over
@@ -411,11 +323,11 @@ class InverseDynamicsNode(SharedGraphNode):
                 if state is None:           # no commanded joint in it
                     self.counts['held'] += 1
                     return
-                tau = ff.state_torques(*state, _seconds(msg.header.stamp),
+                tau = ff.state_torques(*state, seconds(msg.header.stamp),
                                        now)
             else:
                 tau = ff.torques(msg.name, msg.position, msg.velocity,
-                                 _seconds(msg.header.stamp), now)
+                                 seconds(msg.header.stamp), now)
             # the torques left the wrench out once it was too old: say so
             # once, with the first state answered without it
             if ff.wrench.expire(now):
@@ -478,7 +390,7 @@ class InverseDynamicsNode(SharedGraphNode):
                 msg.header.frame_id,
                 (w.force.x, w.force.y, w.force.z,
                  w.torque.x, w.torque.y, w.torque.z),
-                _seconds(msg.header.stamp), self._now())
+                seconds(msg.header.stamp), self._now())
         except InputRejected as exc:
             self._reject('wrench', exc)
         except Exception as exc:
@@ -490,9 +402,9 @@ class InverseDynamicsNode(SharedGraphNode):
             self._no_model('reference')
             return
         try:
-            points = [(_seconds(pt.time_from_start), pt.accelerations)
+            points = [(seconds(pt.time_from_start), pt.accelerations)
                       for pt in msg.points]
-            ff.reference.set(msg.joint_names, _seconds(msg.header.stamp),
+            ff.reference.set(msg.joint_names, seconds(msg.header.stamp),
                              points, self._now())
         except InputRejected as exc:
             self._reject('reference', exc)
@@ -505,141 +417,54 @@ class InverseDynamicsNode(SharedGraphNode):
             self._no_model('trajectory')
             return
         try:
-            points = [{'time_from_start': _seconds(pt.time_from_start),
+            points = [{'time_from_start': seconds(pt.time_from_start),
                        'positions': pt.positions,
                        'velocities': pt.velocities,
                        'accelerations': pt.accelerations}
                       for pt in msg.points]
-            w, frame = (ff.wrench.current(self._now())
-                        if self.params['trajectory.include_wrench']
-                        else (None, 'base'))
-            efforts = trajectory_efforts(ff.model, msg.joint_names, points,
-                                         w, frame, 'trajectory: ', ff.ws,
-                                         drives=ff.drives,
-                                         gravity=not
-                                         ff.robot_compensates_gravity,
-                                         hold=self._hold(ff, msg))
-        except NewtonEulerError as exc:
-            self._reject('trajectory', InputRejected('malformed', str(exc)))
-            return
-        except Exception as exc:
+            efforts, exceeded = ff.trajectory(
+                msg.joint_names, points, self._now(),
+                self.params['trajectory.include_wrench'])
+        except Exception as exc:  # InputRejected, or never let it kill
             self._reject('trajectory', exc)
             return
-        out = efforts.copy()
-        exceeded = False
-        # the bounds of the trajectory's joints, in its order
-        where = {name: k for k, name in enumerate(ff.output_names)}
-        guard = TorqueGuard(ff.guard.bounds[[where[name] for name in
-                                             msg.joint_names]],
-                            ff.guard.action)
-        for k in range(out.shape[0]):
-            row, over = guard.check(efforts[k])
-            exceeded |= over
-            if row is None:
-                self._over_limit(ff, 'trajectory effort')
-                return
-            out[k] = row
         if exceeded:
             self._over_limit(ff, 'trajectory effort')
-        for pt, effort in zip(msg.points, out):
+        if efforts is None:
+            return
+        for pt, effort in zip(msg.points, efforts):
             pt.effort = effort.tolist()
         self.traj_pub.publish(msg)
         self.counts['trajectories'] += 1
-
-    @staticmethod
-    def _hold(ff, msg):
-        """Return where a whole robot's joints a trajectory leaves out are."""
-        if ff.merger is None or set(ff.model.joint_names) <= set(
-                msg.joint_names):
-            return None
-        if ff.last_q is None:
-            raise InputRejected(
-                'no_state', f'the trajectory names {len(msg.joint_names)} of '
-                f'the {ff.model.n} joints, and no joint state has arrived '
-                f'yet to hold the others at')
-        return ff.last_q
 
     def _on_compute_dynamics(self, request, response):
         self.counts['service_calls'] += 1
         ff = self.ff
         if ff is None:
             self.counts['service_failures'] += 1
-            response.success = False
-            response.message = self._no_model_text()
-            return response
+            return failed(response, self._no_model_text())
         try:
-            D, C, g, tau = ff.terms(
-                request.name, request.position, request.velocity,
-                request.acceleration, self._now())
+            return answer(response, ff, request, self._now())
         except (InputRejected, NewtonEulerError) as exc:
-            self.counts['service_failures'] += 1
-            response.success = False
-            response.message = str(exc)
-            return response
+            message = str(exc)
         except Exception as exc:
             self._reject('service request', exc)
-            self.counts['service_failures'] += 1
-            response.success = False
-            response.message = f'internal error: {exc}'
-            return response
-        response.success = True
-        response.message = ''
-        response.name = list(ff.output_names)
-        response.mass_matrix = D.ravel().tolist()
-        response.coriolis_matrix = C.ravel().tolist()
-        response.gravity = g.tolist()
-        response.torque = tau.tolist()
-        return response
+            message = f'internal error: {exc}'
+        self.counts['service_failures'] += 1
+        return failed(response, message)
 
     def _no_model_text(self):
-        """Say why there is no model: waiting, or the description rejected."""
-        rejected = self.description_rejected
-        if rejected:
-            return (f'no robot model: robot_description rejected: '
-                    f'{rejected}')
-        return 'no robot model yet (waiting for robot_description)'
+        return no_model_text(self.description_rejected)
 
     def _publish_counts(self):
         release_memory()
-        ff = self.ff
-        rejected = self.description_rejected
-        if ff is None:
-            level, message = (
-                DiagnosticStatus.ERROR if rejected else DiagnosticStatus.WARN,
-                f'{self._no_model_text()}: publishing nothing')
-        elif rejected:
-            level, message = DiagnosticStatus.WARN, (
-                f'input counters; the last robot_description was rejected '
-                f'({rejected}); the previous model keeps working')
-        else:
-            level, message = DiagnosticStatus.OK, 'input counters'
-        status = DiagnosticStatus(
-            level=level, name=self.get_fully_qualified_name(),
-            message=message,
-            hardware_id=ff.model.name if ff is not None else '')
-        status.values = [KeyValue(key=k, value=str(v))
-                         for k, v in self.counts.items()]
-        model = DiagnosticStatus(
-            level=DiagnosticStatus.OK, name=self.get_fully_qualified_name()
-            + ': model', message=f'mode {self.mode}',
-            hardware_id=ff.model.name if ff is not None else '')
-        model.values = [
-            KeyValue(key='mode', value=self.mode),
-            KeyValue(key='robot_compensates_gravity', value=str(
-                self.params['robot_compensates_gravity']).lower()),
-            KeyValue(key='payload.mass', value=repr(self.payload[0])),
-            KeyValue(key='payload.com', value=repr(list(self.payload[1]))),
-            KeyValue(key='payload.inertia',
-                     value=repr(list(self.payload[2]))),
-            KeyValue(key='source', value=clip(self.model_source, 400)),
-            KeyValue(key='limits.action', value=self.params['limits.action']),
-            KeyValue(key='torque_bounds', value=repr(
-                ff.guard.bounds.tolist() if ff is not None else [])),
-            KeyValue(key='torque_bound_sources', value=repr(
-                ff.bound_sources if ff is not None else []))]
-        msg = DiagnosticArray(status=[status, model]
-                              + ([] if self._observer is None
-                                 else [self._observer.diagnostics()]))
+        status = diagnostics(self.get_fully_qualified_name(), self.ff,
+                             self.counts, self.mode, self.params,
+                             self.payload, self.model_source,
+                             self.description_rejected)
+        if self._observer is not None:
+            status.append(self._observer.diagnostics())
+        msg = DiagnosticArray(status=status)
         msg.header.stamp = self.get_clock().now().to_msg()
         self.diag_pub.publish(msg)
 

@@ -37,16 +37,12 @@ import numpy as np
 from sensor_msgs.msg import JointState
 from std_msgs.msg import Bool
 
-from .common import ConfigurationError, qos_profile, QUIET
+from .common import ConfigurationError, qos_profile, QUIET, seconds
 from ..core import NewtonEulerError
 from ..core import observer as momentum
 from ..core.effects import friction_torque
 from ..core.text import clip
-from ..feedforward import InputRejected
-
-
-def _seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
+from ..joint_inputs import InputRejected
 
 
 class NodeObserver:
@@ -208,7 +204,7 @@ class NodeObserver:
 
     def _run(self, ff, msg, effort):
         obs = self.observer_for(ff)
-        stamp = _seconds(msg.header.stamp) or \
+        stamp = seconds(msg.header.stamp) or \
             self.node.get_clock().now().nanoseconds * 1e-9
         r, what = momentum.observer_step(obs, self.state, stamp, ff.last_q,
                                          ff.last_qd, effort)

@@ -70,17 +70,15 @@ from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
-                     declare_parameters, qos_profile, run_node,
+                     declare_parameters, qos_profile, run_node, seconds,
                      SharedGraphNode)
 from ..core import NewtonEulerError
 from ..core.trajectory import TrajectoryFollower
-from ..feedforward import payload_model
+from ..feedforward_build import PAYLOAD, payload_model
 from ..parameters import load_specs
 from ..safety import effort_bounds, TorqueGuard
 from ..sim.scene import load_scene
 from ..sim.simulate import integrator_step, SceneDynamics
-
-PAYLOAD = ('payload.mass', 'payload.com', 'payload.inertia', 'payload.link')
 
 FRAME_IDS = {'base': 'base_link', 'end_effector': 'tool0'}
 FRAME_OF = {'base_link': 'base', 'base': 'base', 'tool0': 'end_effector',
@@ -357,12 +355,11 @@ class RobotSimNode(SharedGraphNode):
                                f'{self.t:.3f} s')
 
     def _on_trajectory(self, msg):
-        stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        stamp = seconds(msg.header.stamp)
         if stamp == 0.0:
             stamp = self.get_clock().now().nanoseconds * 1e-9
         try:
-            points = [{'time_from_start': p.time_from_start.sec
-                       + p.time_from_start.nanosec * 1e-9,
+            points = [{'time_from_start': seconds(p.time_from_start),
                        'positions': p.positions, 'velocities': p.velocities,
                        'effort': p.effort} for p in msg.points]
             self.follower.set(msg.joint_names, stamp, points)
@@ -396,8 +393,7 @@ class RobotSimNode(SharedGraphNode):
         frame = FRAME_OF.get(msg.header.frame_id)
         f, n = msg.wrench.force, msg.wrench.torque
         w = np.array([f.x, f.y, f.z, n.x, n.y, n.z])
-        stamp = msg.header.stamp
-        ahead = (stamp.sec + stamp.nanosec * 1e-9
+        ahead = (seconds(msg.header.stamp)
                  - self.get_clock().now().nanoseconds * 1e-9)
         if frame is None or not np.isfinite(w).all() or ahead > FUTURE:
             # a clock running ahead is as wrong as a bad frame (as for

@@ -54,7 +54,7 @@ from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
 from .common import (ConfigurationError, declare_parameters, qos_profile,
-                     run_node, SharedGraphNode)
+                     run_node, seconds, SharedGraphNode)
 from ..core import NewtonEulerError
 from ..parameters import load_specs
 from ..sim.scene import load_scene
@@ -68,10 +68,6 @@ REPUBLISH = 0.1         # seconds between checks to republish the reference
 
 def _key(stamp):
     return (stamp.sec, stamp.nanosec)
-
-
-def _seconds(stamp):
-    return stamp.sec + stamp.nanosec * 1e-9
 
 
 def reference_message(scene, names, t0_stamp, sample=SAMPLE):
@@ -175,7 +171,7 @@ class TrackingControllerNode(SharedGraphNode):
         return np.asarray(values, dtype=float)[idx]
 
     def _on_start(self, msg):
-        t0 = _seconds(msg.stamp)
+        t0 = seconds(msg.stamp)
         if t0 != self.t0:
             self.t0, self.t0_stamp = t0, msg.stamp
             self._ref_msg = None
@@ -215,7 +211,7 @@ class TrackingControllerNode(SharedGraphNode):
                                       throttle_duration_sec=2.0)
             return
         key = _key(msg.header.stamp)
-        t = _seconds(msg.header.stamp) - self.t0
+        t = seconds(msg.header.stamp) - self.t0
         if not self.use_ff:
             self._command(t, q, qd, np.zeros(self.n))
             return

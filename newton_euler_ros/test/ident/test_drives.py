@@ -20,8 +20,9 @@ from descriptions import as_published
 from newton_euler_ros.core import inverse_dynamics, load_robot, RobotFileError
 from newton_euler_ros.core.drives import Drives, DRIVES_NS, model_drives
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf
-from newton_euler_ros.feedforward import (FeedforwardComputer, JointOrder,
-                                          WrenchInput)
+from newton_euler_ros.feedforward import FeedforwardComputer
+from newton_euler_ros.joint_inputs import JointOrder
+from newton_euler_ros.wrenches import WrenchInput
 import numpy as np
 import pytest
 

@@ -23,10 +23,10 @@ import re
 import warnings
 
 from newton_euler_ros.core import inverse_dynamics, load_robot, mass_matrix
-from newton_euler_ros.feedforward import (APPLIED_TO_ROBOT,
-                                          FeedforwardComputer, InputRejected,
-                                          JointOrder, ReferenceTrajectory,
-                                          WrenchInput)
+from newton_euler_ros.feedforward import FeedforwardComputer
+from newton_euler_ros.joint_inputs import (InputRejected, JointOrder,
+                                           ReferenceTrajectory)
+from newton_euler_ros.wrenches import APPLIED_TO_ROBOT, WrenchInput
 import numpy as np
 import pytest
 
@@ -215,3 +215,50 @@ def test_computer_built_in_one_call_from_parameters(puma):
     plain = FeedforwardComputer(puma, order, WrenchInput([], []))
     assert plain.guard is None and plain.velocity_bounds is None
     assert (plain.max_future, plain.max_age) == (1.0, 0.0)
+
+
+def test_a_trajectorys_efforts_are_guarded_by_its_joints_bounds(puma):
+    from newton_euler_ros.safety import effort_bounds
+    order = JointOrder(puma.joint_names, list(reversed(puma.joint_names)))
+    params = {'limits.action': 'clamp', 'limits.velocity_factor': 2.0,
+              'limits.max_velocity': 20.0, 'joint_states.max_future': 0.5,
+              'joint_states.max_age': 0.0}
+    names = names6()[2:] + names6()[:2]         # its own order
+    rng = np.random.default_rng(11)
+    Q, QD, QDD = rng.normal(size=(3, 3, 6))
+    points = [{'time_from_start': 0.1 * k, 'positions': Q[k],
+               'velocities': QD[k], 'accelerations': QDD[k]}
+              for k in range(3)]
+    at = [puma.joint_names.index(j) for j in names]
+    expected = np.array([inverse_dynamics(puma, Q[k][np.argsort(at)],
+                                          QD[k][np.argsort(at)],
+                                          QDD[k][np.argsort(at)])[at]
+                         for k in range(3)])
+    # one joint's bound (model order) below what the trajectory asks
+    bounds, sources = effort_bounds(puma)
+    j = int(np.argmax(np.abs(expected).max(axis=0)))
+    low = bounds.copy()
+    low[at[j]] = 0.5 * np.abs(expected[:, j]).max()
+    for action in ('clamp', 'drop', 'publish'):
+        params['limits.action'] = action
+        ff = FeedforwardComputer.from_parameters(
+            params, puma, order, WrenchInput([], []), low, sources)
+        efforts, exceeded = ff.trajectory(names, points, 0.0)
+        assert exceeded
+        if action == 'drop':
+            assert efforts is None
+            continue
+        want = expected.copy()
+        if action == 'clamp':
+            want[:, j] = np.clip(want[:, j], -low[at[j]], low[at[j]])
+        np.testing.assert_allclose(efforts, want, rtol=0, atol=1e-9)
+    # within its bounds: the inverse dynamics at every point, unguarded
+    ff = FeedforwardComputer.from_parameters(
+        params, puma, order, WrenchInput([], []), bounds * 1e3, sources)
+    efforts, exceeded = ff.trajectory(names, points, 0.0)
+    assert not exceeded
+    np.testing.assert_allclose(efforts, expected, rtol=0, atol=1e-9)
+    with pytest.raises(InputRejected, match='trajectory: ') as info:
+        ff.trajectory(names, [{'time_from_start': 0.0,
+                               'positions': [0.0]}], 0.0)
+    assert info.value.kind == 'malformed'

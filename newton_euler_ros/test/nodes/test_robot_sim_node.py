@@ -227,7 +227,7 @@ PAYLOAD = {'mass': 2.0, 'com': [0.02, -0.01, 0.08],
 def offline_states(scene, ticks, switch):
     """(q, qd) at ticks 0..ticks, the payload on the plant from tick ``switch``."""
     import dataclasses
-    from newton_euler_ros.feedforward import payload_model
+    from newton_euler_ros.feedforward_build import payload_model
     from newton_euler_ros.nodes.robot_sim_node import advance
     from newton_euler_ros.sim.simulate import SceneDynamics
 

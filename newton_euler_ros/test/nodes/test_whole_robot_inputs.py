@@ -16,16 +16,18 @@
 A whole robot's inputs without ROS: partial joint states, sensors at links.
 
 On published URDFs (Baxter: two arms, a head, a mimic finger in each
-gripper; Unitree's Z1, a tree with a single tip): the rules
-of ``whole_robot`` one by one, and the wrenches the sensors give against
-sum J_link^T F from the Jacobians of the links.
+gripper; Unitree's Z1, a tree with a single tip): the rules of
+``whole_robot.JointStateMerger`` and ``wrenches.LinkWrenches`` one by
+one, and the wrenches the sensors give against sum J_link^T F from the
+Jacobians of the links.
 """
 import warnings
 
 from newton_euler_ros.core import (frame_pose, inverse_dynamics, jacobian,
                                    load_urdf)
-from newton_euler_ros.feedforward import InputRejected
-from newton_euler_ros.whole_robot import JointStateMerger, LinkWrenches
+from newton_euler_ros.joint_inputs import InputRejected
+from newton_euler_ros.whole_robot import JointStateMerger
+from newton_euler_ros.wrenches import LinkWrenches
 import numpy as np
 import pytest
 
@@ -179,3 +181,38 @@ def test_a_tree_with_one_tip_takes_base_frames_at_its_end_effector():
     # the end effector is the leaf link of the tree
     assert np.allclose(frame_pose(z1, q, 'end_effector'),
                        frame_pose(z1, q, z1.info['urdf']['tip']))
+
+
+def test_a_trajectory_of_one_arm_holds_the_others_where_they_are(baxter):
+    """The node's computer of a whole robot, built as the node builds it."""
+    from newton_euler_ros.feedforward_build import build_computer, PAYLOAD
+    from newton_euler_ros.parameters import load_specs
+    params = {s.name: s.default for s in load_specs()}
+    left = [j for j in baxter.joint_names if j.startswith('left')]
+    params['joints'] = left
+    ff = build_computer(params, 'gravity_coriolis', baxter,
+                        tuple(params[k] for k in PAYLOAD))
+    assert ff.merger is not None and ff.order.command == len(left)
+    rng = np.random.default_rng(7)
+    Q, QD, QDD = rng.uniform(-1, 1, (3, 2, len(left)))
+    points = [{'time_from_start': float(k), 'positions': Q[k],
+               'velocities': QD[k], 'accelerations': QDD[k]}
+              for k in range(2)]
+    # nothing to hold the head and the other arm at yet
+    assert 'no joint state has arrived' in rejected(
+        'no_state', ff.trajectory, left, points, 0.0)
+    # a whole joint state, then the trajectory of the left arm: the
+    # others stay at its positions, at rest
+    q = rng.uniform(-0.5, 0.5, baxter.n)
+    state = ff.merger.merge(baxter.joint_names, q, np.ones(baxter.n), [],
+                            0.0)
+    ff.state_torques(*state, 0.0, 0.0)
+    efforts, exceeded = ff.trajectory(left, points, 0.0)
+    at = [baxter.joint_names.index(j) for j in left]
+    for k in range(2):
+        qk, qdk, qddk = q.copy(), np.zeros(baxter.n), np.zeros(baxter.n)
+        qk[at], qdk[at], qddk[at] = Q[k], QD[k], QDD[k]
+        expected = inverse_dynamics(baxter, qk, qdk, qddk)[at]
+        np.testing.assert_allclose(efforts[k], expected, rtol=0,
+                                   atol=1e-9 * (1 + np.abs(expected).max()))
+    assert not exceeded
