@@ -454,7 +454,7 @@ class _Recorder:
         self.first = self.last = None
 
     def start(self):
-        from .ident.bag import open_writer, sync_directory, sync_writer
+        from .ident.bag_write import open_writer, sync_directory, sync_writer
         self.writer, self.conn, _ = open_writer(self.args.bag,
                                                 self.args.topic,
                                                 self.args.storage)

@@ -56,7 +56,7 @@ def _panda():
 def synthetic_bag(path, seconds, rate, seed=0):
     """Write a long synthetic recording; efforts from our nominal model."""
     from newton_euler_ros.core import inverse_dynamics_batch
-    from newton_euler_ros.ident.bag import write_joint_states
+    from newton_euler_ros.ident.bag_write import write_joint_states
     model = _panda()
     rng = np.random.default_rng(seed)
     traj = fourier_trajectory(model, rng)

@@ -307,7 +307,7 @@ def record(arm, path, motion, rate=100.0, effort='current', payload=None,
     'torque' (what the drives apply, N m), 'friction', 'external'
     (J^T F of the pushes) and 'current' (A, noiseless).
     """
-    from newton_euler_ros.ident.bag import write_joint_states
+    from newton_euler_ros.ident.bag_write import write_joint_states
     if effort not in ('current', 'torque'):
         raise ValueError(f"effort must be 'current' or 'torque', not "
                          f'{effort!r}')

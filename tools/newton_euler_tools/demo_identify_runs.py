@@ -271,7 +271,7 @@ class LoopRun:
         qd = np.array([states[i][2] for i in idx])
         effort = np.array([states[i][3] for i in idx])
         if bag is not None:
-            from newton_euler_ros.ident.bag import write_joint_states
+            from newton_euler_ros.ident.bag_write import write_joint_states
             if os.path.exists(bag):
                 shutil.rmtree(bag)
             write_joint_states(bag, ns[idx], rec.names, q, qd, effort)

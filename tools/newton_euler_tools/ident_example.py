@@ -220,7 +220,7 @@ def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
     """Write the files the module docstring lists; return their paths."""
     import warnings
     from newton_euler_ros.core import load_robot
-    from newton_euler_ros.ident.bag import write_joint_states
+    from newton_euler_ros.ident.bag_write import write_joint_states
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng(seed)
     nominal_path = os.path.join(out_dir, 'panda.urdf')

@@ -36,7 +36,7 @@ import warnings
 
 from newton_euler_ros.core import inspect_robot, NewtonEulerError
 from newton_euler_ros.core.dynamics import inverse_dynamics, jacobian
-from newton_euler_ros.ident.bag import write_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 import numpy as np
 
 

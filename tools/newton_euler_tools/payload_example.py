@@ -69,7 +69,7 @@ def record(path, model, drives, mass, com, inertia_c, seconds=30.0,
            storage='mcap'):
     """Write a recording of the Panda with the payload; return its path."""
     import pinocchio as pin
-    from newton_euler_ros.ident.bag import write_joint_states
+    from newton_euler_ros.ident.bag_write import write_joint_states
     from .peers import PinocchioUrdf
     peer = PinocchioUrdf(panda_path(), model.joint_names, TIP)
     if mass > 0:

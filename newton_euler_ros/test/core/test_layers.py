@@ -132,6 +132,19 @@ def test_ros_adapter_modules_are_short():
                       f'them along what they do): {long}')
 
 
+def test_simulation_and_identification_modules_are_short():
+    paths = [os.path.join(PACKAGE, part, name)
+             for part in ('sim', 'ident')
+             for name in os.listdir(os.path.join(PACKAGE, part))
+             if name.endswith('.py')]
+    names = {os.path.relpath(path, PACKAGE) for path in paths}
+    assert {'sim/simulate.py', 'ident/fit.py', 'ident/bag.py'} <= names
+    long = {os.path.relpath(path, PACKAGE): n
+            for path, n in _long(paths).items()}
+    assert not long, (f'sim/ and ident/ modules over {MAX_LINES} lines '
+                      f'(split them along what they do): {long}')
+
+
 def test_the_size_check_sees_a_long_module(tmp_path):
     short, long = tmp_path / 'short.py', tmp_path / 'long.py'
     short.write_text('x = 1\n' * MAX_LINES)

@@ -13,9 +13,8 @@
 # limitations under the License.
 
 """Reading JointState from real rosbag2 files (MCAP and sqlite3)."""
-from newton_euler_ros.ident.bag import (BagError, iter_joint_states,
-                                        read_joint_states,
-                                        write_joint_states)
+from newton_euler_ros.ident.bag import BagError, iter_joint_states, read_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 import numpy as np
 import pytest
 
@@ -121,7 +120,7 @@ def test_bad_bags_one_line(tmp_path, case, match):
 
 def _synced(path, storage, m, every):
     """Write as ``newton-euler record`` does: on the disk every few."""
-    from newton_euler_ros.ident.bag import open_writer, sync_writer
+    from newton_euler_ros.ident.bag_write import open_writer, sync_writer
     rng = np.random.default_rng(4)
     t = 1_700_000_000_000_000_000 + np.arange(m, dtype=np.int64) * 10 ** 7
     q = rng.normal(size=(m, len(ALL)))

@@ -20,7 +20,8 @@ import sys
 import warnings
 
 from newton_euler_ros.core import inverse_dynamics_batch, load_robot
-from newton_euler_ros.ident.bag import read_joint_states, write_joint_states
+from newton_euler_ros.ident.bag import read_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 from newton_euler_tools.ident_example import (BASE, make_example,
                                               panda_path, TIP)
 import numpy as np

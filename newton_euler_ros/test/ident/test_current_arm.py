@@ -38,7 +38,8 @@ import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.drives import model_drives
-from newton_euler_ros.ident.bag import read_joint_states, write_joint_states
+from newton_euler_ros.ident.bag import read_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 from newton_euler_tools import current_arm_example as arm_example
 from newton_euler_tools.current_arm_example import BASE, JOINTS, TIP
 import numpy as np

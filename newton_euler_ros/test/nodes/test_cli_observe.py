@@ -33,7 +33,7 @@ import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.drives import DRIVES_NS
-from newton_euler_ros.ident.bag import write_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 import numpy as np
 import pytest
 import reference_dynamics as ref

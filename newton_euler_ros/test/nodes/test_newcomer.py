@@ -31,7 +31,7 @@ import subprocess
 import sys
 import time
 
-from newton_euler_ros.ident.bag import write_joint_states
+from newton_euler_ros.ident.bag_write import write_joint_states
 from newton_euler_tools.ident_example import BASE, make_example, TIP
 import numpy as np
 import pytest
