@@ -27,6 +27,15 @@ the constants over the joints the nominal model explains, weighted by
 how well, is held at the nominal model's ratio ``effort.ratios``) or, with
 a recording of a known mass at the tip, by that mass.
 
+On a tree the scale is one per group of coordinates that share
+parameters (:func:`coupled_groups`): the two arms of a dual-arm robot
+mounted on a fixed base share none, so each arm's inertials and
+constants scaled together fit its own rows equally well, whatever the
+other arm does.  Each group's scale is held apart (the nominal model's
+mean over that group); a known mass fixes the scale of the group whose
+joints carry it (a torso joint carrying both arms joins them in one
+group), the others keep the nominal model's.
+
 Variable projection: for given constants, the best theta is a linear
 least-squares problem (the reduced, weighted rows of ``problem.stacked``,
 joint j's weighted by 1 / (sigma_j K_j) with sigma_j its residual in the
@@ -91,6 +100,38 @@ class _Projected:
         return x, np.concatenate(parts)
 
 
+def coupled_groups(model):
+    """
+    Return the groups of coordinates (index arrays) that share parameters.
+
+    Coordinate j's torque depends on the bodies below its joint (and a
+    mimic follower's on its leader's row), so two coordinates share
+    parameters exactly when they are in the same subtree hanging from
+    the base, or in subtrees joined by a follower and its leader.  A
+    chain is one group.
+    """
+    parents, mimic = model.parents, model.mimic
+    root = []
+    for b in range(model.nb):
+        r = b
+        while parents[r] >= 0:
+            r = parents[r]
+        root.append(r)
+    top = {r: r for r in root}
+
+    def find(r):
+        while top[r] != r:
+            r = top[r]
+        return r
+    for b, m in enumerate(mimic):
+        if m is not None:
+            top[find(root[b])] = find(root[m[0]])
+    groups = {}
+    for j, b in enumerate(model.independent):
+        groups.setdefault(find(root[b]), []).append(j)
+    return [np.array(g) for g in groups.values()]
+
+
 def mass_excitation(recording, layout, sigma):
     """
     How much a known mass's torque changes, per joint, in residual units.
@@ -115,14 +156,16 @@ def mass_excitation(recording, layout, sigma):
 
 
 def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
-                  free, pin=None, mass=None):
+                  free, pins=(), mass=None):
     """
     Return the torque constants (n,).
 
     ``free`` marks the joints the data determines (the others get the
-    mean of theirs); ``pin`` (weights c, sum 1) holds sum c log(K / k0)
-    at 0 when there is no ``mass`` (kg at the tip of the loaded
-    recording).
+    mean of theirs); ``pins`` [(group, c)]: for each group of
+    coordinates (indices) whose scale the data does not fix (no ``mass``,
+    kg at the known-mass link of the loaded recording, carried by it),
+    sum c log(K / k0) over its free joints is held at 0 (c >= 0 per
+    joint; uniform where it is 0 throughout the group).
     """
     from scipy.optimize import least_squares
     # the prior toward the nominal model must not choose the scale (it would
@@ -132,11 +175,18 @@ def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
     proj = _Projected(recordings, layout, width, sigma_e,
                       min(lam, PRIOR_WEIGHT), D, theta0, mass)
     idx = np.flatnonzero(free)
-    c = None if pin is None else pin[idx] / pin[idx].sum()
+    shifts = []
+    for group, c in pins:
+        inside = np.isin(idx, group)
+        if not inside.any():
+            continue
+        cc = np.where(inside, c[idx], 0.0)
+        cc = cc if cc.sum() > 0 else inside.astype(np.float64)
+        shifts.append((inside, cc / cc.sum()))
 
     def constants(u):
-        if c is not None:
-            u = u - c @ u
+        for inside, cc in shifts:
+            u = u - (cc @ u) * inside
         K = np.array(k0, dtype=np.float64)
         K[idx] = k0[idx] * np.exp(u)
         K[~free] = K[idx].mean()

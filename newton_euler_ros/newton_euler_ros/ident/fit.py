@@ -83,7 +83,7 @@ import numpy as np
 from . import effort as effort_units
 from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
-from .constants import fit_constants, mass_excitation
+from .constants import coupled_groups, fit_constants, mass_excitation
 from .problem import (joint_stats, Layout, Recording, recording_rows,
                       stacked)
 from .reduce import IdentificationError, reduce_recording
@@ -308,19 +308,30 @@ def _check_units(recordings, layout, theta0, model, mode, k_given, urdf):
     return out
 
 
-def _scale_pin(ratios, k0):
+def _scale_pins(ratios, model, carried, notes, link):
     """
-    Weights c (sum 1) of the joints whose constants' mean fixes the scale.
+    [(group, weights c)]: the groups whose scale the nominal model fixes.
 
     The joints where the nominal model explains the effort (``effort``:
     gravity-loaded joints) count by how well it does: the data fixes the
     constants relative to each other, the nominal model's masses and
-    gravity their mean (``constants.fit_constants``).
+    gravity their mean (``constants.fit_constants``), per group of
+    coordinates that share parameters (``constants.coupled_groups``)
+    except the one whose joints carry the known mass (``carried``).
     """
-    c = np.zeros(len(k0))
+    c = np.zeros(model.n)
     for k, e in ratios.values():
         c += np.where((e >= effort_units.MIN_EXPLAINED) & (k > 0), e, 0.0)
-    return c / c.sum()
+    groups = coupled_groups(model)
+    pins = [(g, c) for g in groups if not set(g.tolist()) & set(carried)]
+    if carried and pins:
+        others = [model.joint_names[j] for g, _ in pins for j in g]
+        more = ' ...' if len(others) > 4 else ''
+        notes.append(f'the known mass at {link} fixes the torque constants '
+                     f'of the joints that share parameters with it; those of '
+                     f'{", ".join(others[:4])}{more} keep the nominal '
+                     f"model's scale")
+    return pins
 
 
 def _check_mass(recording, layout, sigma):
@@ -433,7 +444,7 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
                        _scales(model, theta0, D, layout, mass, Aall), mass)
     lam, width, lam_errors, width_errors = _choose(
         program, recordings, layout, w, k0)
-    K, free = k0, None
+    K, free, notes = k0, None, []
     if estimate_k:
         # the joints whose effort the first fit's rigid-body torque explains
         Aall, _ = stacked(recordings, 'all', layout, width, w, k0)
@@ -442,9 +453,12 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
         if x is not None:
             free |= _determined(_ratios(recordings, layout,
                                         x[:layout.p_theta]), n)
+        from .payload import carrying
+        carried = carrying(model, frame[0]) if known else []
         K = fit_constants(
             recordings, layout, width, sigma_e, k0, lam, D, theta0, free,
-            None if known else _scale_pin(ratios, k0), mass)
+            _scale_pins(ratios, model, carried, notes,
+                        frame[2] if known else None), mass)
         w = 1.0 / (sigma_e * K)
     Aall, _ = stacked(recordings, 'all', layout, width, w, K)
     x = program.solve(Aall, lam, 'final')
@@ -471,7 +485,7 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
         recordings=[(r.path, r.info) for r in recordings],
         undetermined_k=([] if free is None
                         else [int(j) for j in np.flatnonzero(~free)]),
-        mass_excitation=excited,
+        mass_excitation=excited, notes=notes,
         payload_link=None if frame is None else frame[2])
     _report(result, recordings, layout, width, x, K, known, program)
     result.seconds = time.perf_counter() - start

@@ -130,7 +130,7 @@ def payload_frame(model, link=None, option='the link'):
         if model.tool_body is None:
             raise LinkError(
                 f'the tree below {report.get("base", "the base")!r} has '
-                f'several tips ({clip(", ".join(_leaves(model)), 300)}): '
+                f'several tips ({clip(", ".join(_leaves(model)), 600)}): '
                 f'name the link the mass is fixed to with {option}')
         return model.tool_body, np.asarray(model.tool), report.get(
             'tip') or 'the end effector'
