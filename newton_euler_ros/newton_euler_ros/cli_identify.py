@@ -299,7 +299,7 @@ def cmd_identify(args):
         _payload_link(model, args.known_mass_link, args.nominal,
                       '--known-mass-link')
     from .ident.fit import fixed_parts
-    from .ident.problem import REST_SPEED
+    from .ident.problem import REST_FRACTION, REST_SPEED, rest_speeds
     from .ident.urdf_out import atomic_write, identified_urdf
     result = _identify_or_fail(model, text, args)
     names = model.joint_names
@@ -323,6 +323,11 @@ def cmd_identify(args):
     print(f'fitted where each joint moves (|qd| >= {REST_SPEED:g} rad/s: at '
           f'rest static friction holds any torque in its band); the tables '
           f'cover every sample')
+    slow = [f'{names[j]} {v:.2g}' for j, v in enumerate(rest_speeds(model))
+            if v < REST_SPEED]
+    if slow:
+        print(f'  slower joints: {REST_FRACTION:g} of their velocity limit '
+              f'({", ".join(slow)})')
     _print_constants(result, names, 'the tip frame'
                      if args.known_mass_link is None
                      else f'the {args.known_mass_link} frame')

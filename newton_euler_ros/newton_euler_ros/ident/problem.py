@@ -49,6 +49,26 @@ from ..core.regressor import N_DRIVE, N_INERTIAL, regressor_batch
 
 N_PAYLOAD = 10
 REST_SPEED = 0.02     # rad/s (m/s): a joint's slower rows are not fitted
+# ... or, for a joint whose velocity limit is below 10 x REST_SPEED (a
+# torso lift of 0.013 m/s), this fraction of its velocity limit
+REST_FRACTION = 0.1
+
+
+def rest_speeds(model):
+    """
+    Each coordinate's speed below which its rows are not fitted.
+
+    ``REST_SPEED``, or ``REST_FRACTION`` of the joint's URDF velocity
+    limit when that is lower: a slow joint (PR2's torso lifts at
+    0.013 m/s) would otherwise never count as moving.
+    """
+    limits = list(model.limits or ())
+    out = np.full(model.n, REST_SPEED)
+    for j, b in enumerate(model.independent):
+        v = (limits[b] if b < len(limits) else {}).get('velocity', 0.0)
+        if v > 0:
+            out[j] = min(REST_SPEED, REST_FRACTION * v)
+    return out
 
 
 class Layout:
@@ -109,12 +129,14 @@ def recording_rows(model, layout, loaded, frame=None):
     ``payload.payload_frame`` (default: the end effector).
 
     Each joint's fit keeps its rows where it moves at ``REST_SPEED`` or
-    faster: at rest, static friction holds any torque within +-F_s,
+    faster (``rest_speeds``: slower for a slow joint): at rest, static
+    friction holds any torque within +-F_s,
     which no model of (q, qd, qdd) predicts (on UR-like recordings with
     stops, fitting them tripled the error where joints move).
     """
     n = model.n
     extra = layout.widths[1:]
+    rest = rest_speeds(model)
     T = None
     if loaded:
         from .payload import payload_frame, tip_to_link
@@ -134,7 +156,7 @@ def recording_rows(model, layout, loaded, frame=None):
         if T is not None:
             parts.append(Y[:, :, cols] @ T)
         return (np.concatenate(parts, axis=2), effort,
-                np.abs(qd) >= REST_SPEED)
+                np.abs(qd) >= rest)
     return rows
 
 
