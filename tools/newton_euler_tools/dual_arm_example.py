@@ -17,6 +17,7 @@ Recordings of a "real" dual-arm robot (a Baxter), for whole-robot examples.
 
     python -m newton_euler_tools.dual_arm_example OUT_DIR [--seed N]
         [--seconds S] [--rate HZ] [--effort torque|current]
+        [--robot baxter|pr2]
 
 A model of what a Baxter's ``/joint_states`` gives (no real robot was
 recorded): the whole tree below its base link, two 7-joint arms, the
@@ -55,7 +56,13 @@ joint of the first, so 17 coordinates and 19 moving bodies.
   ``left_gripper`` (``identify --effort current --known-mass ...
   --known-mass-link left_gripper``).
 
-Files in OUT_DIR: ``baxter.urdf`` (nominal), the rosbag2 (MCAP)
+``--robot pr2``: the same of example-robot-data's PR2 below
+``base_link``: a prismatic torso lift (0.013 m/s) carrying both arms and
+the head, a laser tilt joint, grippers of five mimic joints each (20
+coordinates, 30 bodies); the payload and known mass on
+``l_gripper_palm_link``.
+
+Files in OUT_DIR: ``ROBOT.urdf`` (nominal), the rosbag2 (MCAP)
 recordings above, and ``truth.json`` (the perturbed URDF, the drives, the
 constants and payloads; for checking, not used by the commands).
 """
@@ -73,6 +80,16 @@ BAXTER = 'baxter_description/urdf/baxter.urdf'
 BASE = 'base'
 TOOL_LINK = 'left_gripper'
 EXTRA = ('torso_t0',)       # a fixed joint Baxter's driver reports
+# the robots: example-robot-data file, base link, the link a tool is
+# fixed to, fixed joints the driver reports
+ROBOTS = {
+    'baxter': {'urdf': BAXTER, 'base': BASE, 'tool': TOOL_LINK,
+               'extra': EXTRA},
+    # a torso lift joint (prismatic, 0.013 m/s) carrying both arms and the
+    # head; grippers of five mimic joints each
+    'pr2': {'urdf': 'pr2_description/urdf/pr2.urdf', 'base': 'base_link',
+            'tool': 'l_gripper_palm_link', 'extra': ()},
+}
 # per kind of coordinate: peak speed (rad/s, m/s), viscous, Coulomb,
 # offset, armature, effort noise, torque constant (N m/A or N/A)
 KINDS = {
@@ -80,6 +97,8 @@ KINDS = {
     'wrist': (1.4, (0.05, 0.3), (0.2, 0.8), 0.15, (0.01, 0.05), 0.02, 1.6),
     'head': (0.8, (0.02, 0.1), (0.1, 0.3), 0.05, (0.005, 0.02), 0.01, 0.8),
     'finger': (0.06, (2.0, 5.0), (0.5, 1.5), 0.2, (0.05, 0.2), 0.05, 6.0),
+    'torso': (0.05, (500.0, 1500.0), (20.0, 60.0), 10.0, (5.0, 20.0), 2.0,
+              60.0),
 }
 COULOMB_WIDTH = 0.01
 FINGER_PERIOD = 1.2        # s: a gripper opens and closes quickly
@@ -92,18 +111,18 @@ KNOWN = {'mass': KNOWN_MASS, 'com': [-0.01, 0.015, 0.05],
                      [0.0, 0.0, 2e-3]]}
 
 
-def baxter_path():
-    """Return the published Baxter URDF's path (example-robot-data)."""
+def baxter_path(robot='baxter'):
+    """Return the published URDF's path (example-robot-data)."""
     from .peers import example_robot_urdf
-    return example_robot_urdf(BAXTER)
+    return example_robot_urdf(ROBOTS[robot]['urdf'])
 
 
-def nominal_model(path):
-    """Load the whole tree below ``BASE`` (warnings off)."""
+def nominal_model(path, base=BASE):
+    """Load the whole tree below ``base`` (warnings off)."""
     from newton_euler_ros.core import load_robot
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        return load_robot(path, base=BASE)
+        return load_robot(path, base=base)
 
 
 def kind(model, j):
@@ -111,9 +130,11 @@ def kind(model, j):
     name = model.joint_names[j]
     if 'finger' in name:
         return 'finger'
-    if name.startswith('head'):
+    if 'torso' in name:
+        return 'torso'
+    if name.startswith(('head', 'laser')):
         return 'head'
-    return 'wrist' if '_w' in name else 'big'
+    return 'wrist' if ('_w' in name or 'wrist' in name) else 'big'
 
 
 def random_drives(model, rng):
@@ -137,8 +158,11 @@ def _ranges(model):
     mid, half, speed = (np.zeros(model.n) for _ in range(3))
     for j, b in enumerate(model.independent):
         lim = model.limits[b]
-        mid[j] = 0.5 * (lim['lower'] + lim['upper'])
-        half[j] = 0.5 * (lim['upper'] - lim['lower'])
+        if 'lower' in lim and 'upper' in lim:
+            mid[j] = 0.5 * (lim['lower'] + lim['upper'])
+            half[j] = 0.5 * (lim['upper'] - lim['lower'])
+        else:                   # continuous: a quarter turn each way
+            half[j] = 0.5 * math.pi
         speed[j] = min(KINDS[kind(model, j)][0],
                        0.9 * lim.get('velocity', np.inf))
     return mid, half, speed
@@ -311,13 +335,13 @@ def friction(drives, qd, rng):
 
 
 def record(model, truth, drives, path, f, rate=100.0, payload=None,
-           effort='torque', seed=0):
+           effort='torque', seed=0, robot='baxter'):
     """Write one recording of the robot following ``f``; return its truth."""
     from newton_euler_ros.ident.bag import write_joint_states
     rng = np.random.default_rng([seed, 5])
     t, twice = _message_times(f.seconds, rate, rng)
     q, qd, qdd = f(t)
-    sim = _Truth(truth, model, payload)
+    sim = _Truth(truth, model, payload, ROBOTS[robot]['tool'])
     torque = (sim.torques(q, qd, qdd) + drives['armature'] * qdd
               + friction(drives, qd, rng) + drives['offset'])
     measured = torque + rng.normal(0.0, 1.0, torque.shape) * drives['noise']
@@ -328,7 +352,7 @@ def record(model, truth, drives, path, f, rate=100.0, payload=None,
     # every joint, sorted as a driver lists them: followers mirror their
     # leader; the fixed joints the driver reports at 0
     coord = {b: k for k, b in enumerate(model.independent)}
-    names = sorted(list(model.moving_joints) + list(EXTRA))
+    names = sorted(list(model.moving_joints) + list(ROBOTS[robot]['extra']))
     cols = []
     for name in names:
         if name not in model.moving_joints:
@@ -358,16 +382,18 @@ def record(model, truth, drives, path, f, rate=100.0, payload=None,
 
 
 def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
-                 effort='torque', validation_seconds=30.0, payload=True):
+                 effort='torque', validation_seconds=30.0, payload=True,
+                 robot='baxter'):
     """Write the files the module docstring lists; return their paths."""
     from .ident_example import perturb_urdf
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng([seed, 1])
-    nominal = os.path.join(out_dir, 'baxter.urdf')
-    shutil.copyfile(baxter_path(), nominal)
+    spec = ROBOTS[robot]
+    nominal = os.path.join(out_dir, f'{robot}.urdf')
+    shutil.copyfile(baxter_path(robot), nominal)
     with open(nominal, encoding='utf-8') as f:
         text = f.read()
-    model = nominal_model(nominal)
+    model = nominal_model(nominal, spec['base'])
     truth = perturb_urdf(text, set(model.info['urdf']['links']), rng)
     drives = random_drives(model, rng)
     paths = {'urdf': nominal}
@@ -381,16 +407,16 @@ def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
         path = os.path.join(out_dir, label)
         record(model, truth, drives, path,
                motion(model, seed + 100 * k, secs, period), rate=rate,
-               payload=load, effort=effort, seed=seed + k)
+               payload=load, effort=effort, seed=seed + k, robot=robot)
         paths[label] = path
     paths['truth'] = os.path.join(out_dir, 'truth.json')
     with open(paths['truth'], 'w', encoding='utf-8') as f:
-        json.dump({'urdf': truth, 'base': BASE, 'effort': effort,
-                   'joints': list(model.joint_names),
+        json.dump({'urdf': truth, 'robot': robot, 'base': spec['base'],
+                   'effort': effort, 'joints': list(model.joint_names),
                    'drives': {k: (v.tolist() if isinstance(v, np.ndarray)
                                   else v) for k, v in drives.items()},
-                   'payload': {'link': TOOL_LINK, **PAYLOAD},
-                   'known_mass': {'link': TOOL_LINK, **KNOWN}}, f)
+                   'payload': {'link': spec['tool'], **PAYLOAD},
+                   'known_mass': {'link': spec['tool'], **KNOWN}}, f)
     return paths
 
 
@@ -404,9 +430,10 @@ def main(argv=None):
     parser.add_argument('--rate', type=float, default=100.0)
     parser.add_argument('--effort', choices=('torque', 'current'),
                         default='torque')
+    parser.add_argument('--robot', choices=sorted(ROBOTS), default='baxter')
     args = parser.parse_args(argv)
     paths = make_example(args.out_dir, args.seed, args.seconds, args.rate,
-                         args.effort)
+                         args.effort, robot=args.robot)
     for key, value in paths.items():
         if key != 'truth':
             print(f'{key}: {value}')
