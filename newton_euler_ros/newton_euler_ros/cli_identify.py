@@ -15,12 +15,19 @@
 """
 ``newton-euler identify`` and ``newton-euler replay``.
 
-    newton-euler identify NOMINAL.urdf BAG [BAG ...] --base LINK --tip LINK
+    newton-euler identify NOMINAL.urdf BAG [BAG ...] --base LINK [--tip LINK]
                           -o IDENTIFIED.urdf [--topic T] [--validate BAG2]
                           [--effort torque|current] [--known-mass BAG KG]
-                          [--coulomb-width EPS] [--cutoff HZ] [--overwrite]
-    newton-euler replay MODEL.urdf BAG --base LINK --tip LINK --csv OUT.csv
+                          [--known-mass-link LINK] [--coulomb-width EPS]
+                          [--cutoff HZ] [--overwrite]
+    newton-euler replay MODEL.urdf BAG --base LINK [--tip LINK] --csv OUT.csv
                         [--plot OUT.png] [--topic T] [--cutoff HZ]
+
+Without ``--tip`` the model is the whole tree below ``--base`` (both arms
+of a dual-arm robot, a torso with arms, an arm with its fingers): every
+body is identified, and every independent joint's drive terms; mimic
+followers move with their leaders (their JointState entries are not
+read).
 
 Every problem with an input (a bag that is missing, corrupt or truncated,
 lacks the topic, the effort or a chain joint, is too short or does not
@@ -67,6 +74,9 @@ def register(subparsers):
                      help='a recording with a known mass added at the tip '
                           'link (its centre of mass and inertia need not be '
                           "known): fixes the torque constants' scale")
+    ide.add_argument('--known-mass-link', metavar='LINK',
+                     help='the link the known mass is fixed to (default: '
+                          'the tip; needed on a tree with several tips)')
     ide.add_argument('--coulomb-width', type=float, metavar='EPS',
                      help='Coulomb smoothing width of tanh(qd / EPS), rad/s '
                           '(default: chosen on held-out blocks among 0.005 '
@@ -92,9 +102,11 @@ def register(subparsers):
 
 def _common(parser):
     parser.add_argument('--base', metavar='LINK', required=True,
-                        help='first link of the chain')
-    parser.add_argument('--tip', metavar='LINK', required=True,
-                        help='last link of the chain')
+                        help='first link of the chain, or the link the '
+                             'whole tree hangs from')
+    parser.add_argument('--tip', metavar='LINK',
+                        help='last link of the chain (default: the whole '
+                             'tree below --base)')
     parser.add_argument('--topic', default='/joint_states',
                         help='JointState topic (default /joint_states)')
     parser.add_argument('--cutoff', type=float, metavar='HZ',
@@ -149,17 +161,32 @@ def _load_urdf(path, base, tip, prior=False):
     return model, text, notes
 
 
+def _cell(fmt, value):
+    """Format a number, or '-' where there is none (NaN: no sample)."""
+    return fmt.format(value) if np.isfinite(value) else '-'
+
+
 def _table(title, names, columns):
-    """Print a per-joint table; columns: [(header, values, fmt)]."""
+    """
+    Print a per-joint table; columns: [(header, values, fmt)].
+
+    A NaN value (a joint that never moves, in a "moving" column) is '-'
+    and left out of the mean.
+    """
     print(title)
     width = max(len(n) for n in names) + 2
     heads = ''.join(f'{h:>18}' for h, _, _ in columns)
     print(f'  {"joint":<{width}}' + heads)
     for j, name in enumerate(names):
         print(f'  {name:<{width}}' + ''.join(
-            f'{fmt.format(v[j]):>18}' for _, v, fmt in columns))
+            f'{_cell(fmt, v[j]):>18}' for _, v, fmt in columns))
+
+    def mean(v):
+        v = np.asarray(v, dtype=np.float64)
+        return float(np.mean(v[np.isfinite(v)])) if np.isfinite(
+            v).any() else float('nan')
     print(f'  {"mean":<{width}}' + ''.join(
-        f'{fmt.format(float(np.mean(v))):>18}' for _, v, fmt in columns))
+        f'{_cell(fmt, mean(v)):>18}' for _, v, fmt in columns))
 
 
 def _stats_table(title, names, stats):
@@ -169,12 +196,15 @@ def _stats_table(title, names, stats):
                           ('nominal rel %', rel0 * 100, '{:.2f}'),
                           ('identified RMS', rms1, '{:.4g}'),
                           ('identified rel %', rel1 * 100, '{:.2f}')])
-    return float(np.mean(rel0)), float(np.mean(rel1))
+    both = np.isfinite(rel0) & np.isfinite(rel1)
+    return float(np.mean(rel0[both])), float(np.mean(rel1[both]))
 
 
 def _known_mass(args):
     """Return (bag, kg) of --known-mass, or None; one line if bad."""
     if args.known_mass is None:
+        if getattr(args, 'known_mass_link', None) is not None:
+            _fail('--known-mass-link needs --known-mass BAG KG')
         return None
     bag, kg = args.known_mass
     try:
@@ -197,7 +227,8 @@ def _identify_or_fail(model, text, args):
                         coulomb_width=args.coulomb_width,
                         cutoff=args.cutoff, urdf_text=text,
                         effort=args.effort, known_mass=known,
-                        urdf_label=args.nominal)
+                        urdf_label=args.nominal,
+                        known_mass_link=args.known_mass_link)
     except (NewtonEulerError, ValueError) as exc:
         line = str(exc)
         files = list(args.bag) + [args.validate, known and known[0]]
@@ -205,7 +236,29 @@ def _identify_or_fail(model, text, args):
         _fail(line if named else f'{args.bag[0]}: {line}')
 
 
-def _print_constants(result, names):
+def _payload_link(model, link, path, option):
+    """Check that ``link`` can carry a mass (payload_frame); one line."""
+    from .ident.payload import LinkError, payload_frame
+    try:
+        return payload_frame(model, link, f'{option} LINK')
+    except LinkError as exc:
+        _fail(f'{path}: {exc}')
+
+
+def _describe(model):
+    """One line on a tree: coordinates, bodies, mimic followers."""
+    report = (model.info or {}).get('urdf') or {}
+    if not report.get('tree'):
+        return None
+    mimic = report.get('mimic') or {}
+    follow = ', '.join(f'{f} = {s:g} x {lead}' + (f' + {o:g}' if o else '')
+                       for f, (lead, s, o) in mimic.items())
+    return (f'whole tree below {report["base"]!r}: {model.n} joints, '
+            f'{model.nb} bodies' + (f'; mimic joints move with their '
+                                    f'leader ({follow})' if follow else ''))
+
+
+def _print_constants(result, names, tip_frame='the tip frame'):
     K = result.torque_constant
     if K is None:
         return
@@ -221,7 +274,7 @@ def _print_constants(result, names):
         print(f'known mass {result.payload["mass"]:g} kg: its torque '
               f'changes by up to {result.mass_excitation.max():.2g} '
               f'residual RMS; centre of mass found at ({1000 * c[0]:.0f}, '
-              f'{1000 * c[1]:.0f}, {1000 * c[2]:.0f}) mm in the tip frame')
+              f'{1000 * c[1]:.0f}, {1000 * c[2]:.0f}) mm in {tip_frame}')
 
 
 def cmd_identify(args):
@@ -242,18 +295,27 @@ def cmd_identify(args):
                                     prior=True)
     for line in notes:
         print(line, file=sys.stderr)
+    if args.known_mass is not None:
+        _payload_link(model, args.known_mass_link, args.nominal,
+                      '--known-mass-link')
     from .ident.fit import fixed_parts
-    from .ident.problem import REST_SPEED
+    from .ident.problem import REST_FRACTION, REST_SPEED, rest_speeds
     from .ident.urdf_out import atomic_write, identified_urdf
     result = _identify_or_fail(model, text, args)
     names = model.joint_names
+    tree = _describe(model)
+    if tree:
+        print(tree)
     for path, info in result.recordings:
         print(f'recording {path}: {info["samples"]} samples over '
               f'{info["duration"]:.1f} s at {info["rate"]:.0f} Hz, low-pass '
               f'{info["cutoff"]:g} Hz, fit on every {info["step"]} '
               f'sample(s)')
+    count = ('10 inertial + 4 drive per joint' if model.nb == model.n
+             else f'10 inertial per body, {model.nb} bodies, + 4 drive per '
+                  f'joint, {model.n} joints')
     print(f'rank {result.rank} of {result.structural_rank} base parameters '
-          f'(of {14 * model.n}: 10 inertial + 4 drive per joint); '
+          f'(of {10 * model.nb + 4 * model.n}: {count}); '
           f'condition number {result.condition:.3g}')
     print(f'prior weight {result.lam:g}, Coulomb width '
           f'{result.coulomb_width:g} rad/s (both chosen on held-out blocks'
@@ -261,7 +323,14 @@ def cmd_identify(args):
     print(f'fitted where each joint moves (|qd| >= {REST_SPEED:g} rad/s: at '
           f'rest static friction holds any torque in its band); the tables '
           f'cover every sample')
-    _print_constants(result, names)
+    slow = [f'{names[j]} {v:.2g}' for j, v in enumerate(rest_speeds(model))
+            if v < REST_SPEED]
+    if slow:
+        print(f'  slower joints: {REST_FRACTION:g} of their velocity limit '
+              f'({", ".join(slow)})')
+    _print_constants(result, names, 'the tip frame'
+                     if args.known_mass_link is None
+                     else f'the {args.known_mass_link} frame')
     unit = ('N m' if result.torque_constant is None else
             'N m: the effort times the torque constants')
     _stats_table(f'torque residual on the recording ({unit}; relative to '
@@ -280,8 +349,8 @@ def cmd_identify(args):
                               result.validate_stats)
         if n1 >= n0:
             worse.append(args.validate)
-    f0 = float(np.mean(result.fit_stats['nominal'][1]))
-    f1 = float(np.mean(result.fit_stats['identified'][1]))
+    f0 = float(np.nanmean(result.fit_stats['nominal'][1]))
+    f1 = float(np.nanmean(result.fit_stats['identified'][1]))
     if f1 >= f0:
         worse.append('the recording')
     fixed = fixed_parts(model, text, prior=True)
@@ -346,6 +415,8 @@ def cmd_replay(args):
     names = model.joint_names
     _write_replay_csv(args.csv, names, ns, meas, mod)
     moving = np.abs(speed) > MOVING
+    if _describe(model):
+        print(_describe(model))
     print(f'{args.bag}: {len(ns)} of {len(js)} messages (filter edges and '
           f'gaps left out); model {args.model}'
           + ('' if drives is not None else ' (no drive terms)'))
@@ -384,8 +455,15 @@ def _rms(err, mask=None):
 
 
 def _rel(model, meas, mask=None):
-    """RMS error relative to the RMS measurement, per column."""
-    return _rms(model - meas, mask) / np.maximum(_rms(meas, mask), 1e-300)
+    """
+    RMS error relative to the RMS measurement, per column.
+
+    NaN for a column whose ``mask`` is false everywhere (no sample).
+    """
+    out = _rms(model - meas, mask) / np.maximum(_rms(meas, mask), 1e-300)
+    if mask is not None:
+        out = np.where(mask.any(axis=0), out, np.nan)
+    return out
 
 
 def _write_replay_csv(path, names, ns, meas, mod):

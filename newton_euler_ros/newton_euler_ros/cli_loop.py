@@ -22,8 +22,11 @@
                         [--max-acceleration A [A ...]] [--clearance M]
                         [--floor Z | --no-floor] [--plane NX NY NZ D]
                         [--box XMIN YMIN ZMIN XMAX YMAX ZMAX]
-    newton-euler payload MODEL.urdf BAG --base LINK --tip LINK [--json]
-                         [--topic T] [--cutoff HZ]
+    newton-euler payload MODEL.urdf BAG --base LINK [--tip LINK]
+                         [--link LINK] [--json] [--topic T] [--cutoff HZ]
+
+``payload`` without ``--tip`` takes the whole tree below ``--base``; the
+payload is fixed to ``--link`` (default: the tip, the tree's single one).
 
 Every problem with an input is one line on stderr naming the file or the
 option, exit status 2.  Files are written atomically.
@@ -36,7 +39,8 @@ import sys
 import numpy as np
 
 # one line on stderr and exit status 2, as identify and replay
-from .cli_identify import _fail, _load_urdf, _one_line_exit_2
+from .cli_identify import (_describe, _fail, _load_urdf, _one_line_exit_2,
+                           _payload_link)
 
 
 def register(subparsers):
@@ -100,14 +104,21 @@ def register(subparsers):
     exc.set_defaults(func=_one_line_exit_2(cmd_excite))
     pay = subparsers.add_parser(
         'payload', help='estimate the mass, centre of mass and inertia of '
-                        'a payload at the tip from a recording')
+                        'a payload at the tip (or a link) from a recording')
     pay.add_argument('model', metavar='MODEL.urdf',
                      help='the arm without the payload (identified URDF)')
     pay.add_argument('bag', metavar='BAG', help='rosbag2 directory')
-    pay.add_argument('--base', metavar='LINK', required=True)
-    pay.add_argument('--tip', metavar='LINK', required=True,
-                     help='the payload is fixed to this link; com in its '
-                          'frame')
+    pay.add_argument('--base', metavar='LINK', required=True,
+                     help='first link of the chain, or the link the whole '
+                          'tree hangs from')
+    pay.add_argument('--tip', metavar='LINK',
+                     help='last link of the chain (default: the whole tree '
+                          'below --base); the payload is fixed to it unless '
+                          '--link says otherwise')
+    pay.add_argument('--link', metavar='LINK',
+                     help='the link the payload is fixed to; com and '
+                          'inertia in its frame (default: the tip; needed '
+                          'on a tree with several tips)')
     pay.add_argument('--topic', default='/joint_states')
     pay.add_argument('--cutoff', type=float, metavar='HZ',
                      help='low-pass cutoff (default as identify)')
@@ -271,9 +282,12 @@ def cmd_payload(args):
     if not args.json:
         for line in notes:
             print(line, file=sys.stderr)
+    _, _, link = _payload_link(model, args.link, args.model, '--link')
+    if not args.json and _describe(model):
+        print(_describe(model))
     try:
         est = estimate_payload(model, args.bag, topic=args.topic,
-                               cutoff=args.cutoff)
+                               cutoff=args.cutoff, link=args.link)
     except (NewtonEulerError, ValueError) as exc:
         text = str(exc)
         _fail(text if text.startswith(str(args.bag))
@@ -283,6 +297,6 @@ def cmd_payload(args):
         for line in est.undetermined_lines():
             print(f'warning: {line}', file=sys.stderr)
         return 0
-    for line in est.summary_lines(args.tip):
+    for line in est.summary_lines(link):
         print(line)
     return 0

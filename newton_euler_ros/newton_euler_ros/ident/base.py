@@ -78,10 +78,14 @@ def random_states(model, count, seed=0):
     n = model.n
     lo = np.full(n, -np.pi)
     hi = np.full(n, np.pi)
-    for j, lim in enumerate(model.limits or ()):
+    limits = list(model.limits or ())
+    # coordinate j is moving joint model.independent[j] (a tree's mimic
+    # followers have no coordinate)
+    for j, b in enumerate(model.independent):
+        lim = limits[b] if b < len(limits) else {}
         if 'lower' in lim and 'upper' in lim and lim['upper'] > lim['lower']:
             lo[j], hi[j] = lim['lower'], lim['upper']
-        elif model.joint_types[j] == 'prismatic':
+        elif model.joint_types[b] == 'prismatic':
             lo[j], hi[j] = -0.5, 0.5
     Q = rng.uniform(lo, hi, (count, n))
     return Q, rng.normal(size=(count, n)), rng.normal(size=(count, n))

@@ -27,6 +27,15 @@ the constants over the joints the nominal model explains, weighted by
 how well, is held at the nominal model's ratio ``effort.ratios``) or, with
 a recording of a known mass at the tip, by that mass.
 
+On a tree the scale is one per group of coordinates that share
+parameters (:func:`coupled_groups`): the two arms of a dual-arm robot
+mounted on a fixed base share none, so each arm's inertials and
+constants scaled together fit its own rows equally well, whatever the
+other arm does.  Each group's scale is held apart (the nominal model's
+mean over that group); a known mass fixes the scale of the group whose
+joints carry it (a torso joint carrying both arms joins them in one
+group), the others keep the nominal model's.
+
 Variable projection: for given constants, the best theta is a linear
 least-squares problem (the reduced, weighted rows of ``problem.stacked``,
 joint j's weighted by 1 / (sigma_j K_j) with sigma_j its residual in the
@@ -41,7 +50,9 @@ found.
 """
 import numpy as np
 
+from . import effort
 from .problem import stacked
+from .reduce import IdentificationError
 
 PRIOR_WEIGHT = 1e-6
 
@@ -91,6 +102,38 @@ class _Projected:
         return x, np.concatenate(parts)
 
 
+def coupled_groups(model):
+    """
+    Return the groups of coordinates (index arrays) that share parameters.
+
+    Coordinate j's torque depends on the bodies below its joint (and a
+    mimic follower's on its leader's row), so two coordinates share
+    parameters exactly when they are in the same subtree hanging from
+    the base, or in subtrees joined by a follower and its leader.  A
+    chain is one group.
+    """
+    parents, mimic = model.parents, model.mimic
+    root = []
+    for b in range(model.nb):
+        r = b
+        while parents[r] >= 0:
+            r = parents[r]
+        root.append(r)
+    top = {r: r for r in root}
+
+    def find(r):
+        while top[r] != r:
+            r = top[r]
+        return r
+    for b, m in enumerate(mimic):
+        if m is not None:
+            top[find(root[b])] = find(root[m[0]])
+    groups = {}
+    for j, b in enumerate(model.independent):
+        groups.setdefault(find(root[b]), []).append(j)
+    return [np.array(g) for g in groups.values()]
+
+
 def mass_excitation(recording, layout, sigma):
     """
     How much a known mass's torque changes, per joint, in residual units.
@@ -115,14 +158,16 @@ def mass_excitation(recording, layout, sigma):
 
 
 def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
-                  free, pin=None, mass=None):
+                  free, pins=(), mass=None):
     """
     Return the torque constants (n,).
 
     ``free`` marks the joints the data determines (the others get the
-    mean of theirs); ``pin`` (weights c, sum 1) holds sum c log(K / k0)
-    at 0 when there is no ``mass`` (kg at the tip of the loaded
-    recording).
+    mean of theirs); ``pins`` [(group, c)]: for each group of
+    coordinates (indices) whose scale the data does not fix (no ``mass``,
+    kg at the known-mass link of the loaded recording, carried by it),
+    sum c log(K / k0) over its free joints is held at 0 (c >= 0 per
+    joint; uniform where it is 0 throughout the group).
     """
     from scipy.optimize import least_squares
     # the prior toward the nominal model must not choose the scale (it would
@@ -132,11 +177,18 @@ def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
     proj = _Projected(recordings, layout, width, sigma_e,
                       min(lam, PRIOR_WEIGHT), D, theta0, mass)
     idx = np.flatnonzero(free)
-    c = None if pin is None else pin[idx] / pin[idx].sum()
+    shifts = []
+    for group, c in pins:
+        inside = np.isin(idx, group)
+        if not inside.any():
+            continue
+        cc = np.where(inside, c[idx], 0.0)
+        cc = cc if cc.sum() > 0 else inside.astype(np.float64)
+        shifts.append((inside, cc / cc.sum()))
 
     def constants(u):
-        if c is not None:
-            u = u - c @ u
+        for inside, cc in shifts:
+            u = u - (cc @ u) * inside
         K = np.array(k0, dtype=np.float64)
         K[idx] = k0[idx] * np.exp(u)
         K[~free] = K[idx].mean()
@@ -145,3 +197,59 @@ def fit_constants(recordings, layout, width, sigma_e, k0, lam, D, theta0,
                         np.zeros(len(idx)), method='trf', x_scale=1.0,
                         diff_step=1e-4, xtol=1e-6, ftol=1e-9)
     return constants(fit.x)
+
+
+def scale_pins(ratios, model, carried, notes, link):
+    """
+    [(group, weights c)]: the groups whose scale the nominal model fixes.
+
+    The joints where the nominal model explains the effort (``effort``:
+    gravity-loaded joints) count by how well it does: the data fixes the
+    constants relative to each other, the nominal model's masses and
+    gravity their mean (``constants.fit_constants``), per group of
+    coordinates that share parameters (``constants.coupled_groups``)
+    except the one whose joints carry the known mass (``carried``).
+    """
+    c = np.zeros(model.n)
+    for k, e in ratios.values():
+        c += np.where((e >= effort.MIN_EXPLAINED) & (k > 0), e, 0.0)
+    groups = coupled_groups(model)
+    pins = [(g, c) for g in groups if not set(g.tolist()) & set(carried)]
+    if carried and pins:
+        others = [model.joint_names[j] for g, _ in pins for j in g]
+        more = ' ...' if len(others) > 4 else ''
+        notes.append(f'the known mass at {link} fixes the torque constants '
+                     f'of the joints that share parameters with it; those of '
+                     f'{", ".join(others[:4])}{more} keep the nominal '
+                     f"model's scale")
+    return pins
+
+
+def determined(ratios, n):
+    """Joints whose effort follows the nominal model's rigid-body torque."""
+    out = np.zeros(n, dtype=bool)
+    for k, e in ratios.values():
+        out |= (e >= effort.MIN_EXPLAINED) & (k > 0)
+    return out
+
+
+def initial_constants(ratios, n):
+    """
+    Each determined joint's ratio (weighted over the bags), else their mean.
+
+    Raises IdentificationError when no joint is determined.
+    """
+    K = np.zeros(n)
+    good = np.zeros(n)
+    for k, e in ratios.values():
+        use = (e >= effort.MIN_EXPLAINED) & (k > 0)
+        K += np.where(use, k * e, 0.0)
+        good += np.where(use, e, 0.0)
+    if not good.any():
+        raise IdentificationError(
+            f"{next(iter(ratios))}: no joint's effort follows the nominal "
+            f"model's torque, so the torque constants cannot be found "
+            f'(record the shoulder and elbow moving against gravity, or '
+            f'give the constants in the URDF)')
+    K = np.where(good > 0, K / np.maximum(good, 1e-300), np.nan)
+    return np.where(np.isnan(K), np.nanmean(K), K)

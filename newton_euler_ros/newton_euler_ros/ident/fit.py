@@ -15,10 +15,16 @@
 """
 Fit inertial and drive parameters to recordings, physically consistent.
 
-The parameters theta = [pi (10n, per link), drives (4n, per joint)] enter
-the torques linearly, tau = Y theta (``core.regressor`` with
+The parameters theta = [pi (10nb, per body), drives (4n, per joint)]
+enter the torques linearly, tau = Y theta (``core.regressor`` with
 ``drives=True``); when the efforts are motor currents, tau_j = K_j e_j
-with a torque constant per joint.  The pipeline:
+with a torque constant per joint.  On a chain nb = n; on a tree (a URDF
+loaded without a tip) the bodies are every moving joint's link, a mimic
+follower's too (its torque acts through its leader's row), and the n
+coordinates are the independent joints, each with its drive terms: the
+follower's friction and rotor inertia act through its leader's drive, so
+a coordinate's drive terms are those of its actuator.  Every step below
+is the same on both.  The pipeline:
 
 1. Read, prepare and reduce each recording (``reduce``, ``problem``):
    per joint, the R factor of its rows, (p + 1)^2 numbers whatever the
@@ -38,7 +44,8 @@ with a torque constant per joint.  The pipeline:
    variable scaled to order one): minimise the mean weighted squared
    residual plus lambda ||D (theta - theta_0)||^2 toward the nominal
    model theta_0, with every link's 4x4 pseudo-inertia positive
-   semi-definite (Wensing, Kim & Slotine 2018), viscous and Coulomb
+   semi-definite (Wensing, Kim & Slotine 2018; every body of a tree),
+viscous and Coulomb
    friction and armature >= 0.  D scales each parameter by its column's
    RMS in the weighted regressor, so lambda is a fraction of what a
    change costs in the data where the data sees it.  Parameters the
@@ -56,9 +63,11 @@ and gravity: the D^2-weighted projection of theta's inertial part on the
 nominal's is held at the nominal's value (the data decides the shape,
 the nominal model the overall size, where gravity sees it).  With a
 recording of a known mass at the tip (its centre of mass and inertia
-unknown, a PSD body of that mass), the mass fixes the scale instead: the
-payload's torque is exactly known up to its centre of mass and inertia,
-the arm's parameters are shared with the other recordings.  Torque
+unknown, a PSD body of that mass; at another link with
+``known_mass_link``, which a tree with several tips needs), the mass
+fixes the scale instead: the payload's torque is exactly known up to its
+centre of mass and inertia, the arm's parameters are shared with the
+other recordings.  Torque
 constants given in the nominal URDF are used as given.
 
 Links carrying rigidly attached children (a URDF's fixed joints and locked
@@ -74,7 +83,8 @@ import numpy as np
 from . import effort as effort_units
 from .bag import DEFAULT_TOPIC
 from .base import base_parameters, structural_base
-from .constants import fit_constants, mass_excitation
+from .constants import (determined, fit_constants, initial_constants,
+                        mass_excitation, scale_pins)
 from .problem import (joint_stats, Layout, Recording, recording_rows,
                       stacked)
 from .reduce import IdentificationError, reduce_recording
@@ -106,14 +116,14 @@ def accumulate(model, path, topic=DEFAULT_TOPIC, coulomb_width=None,
     the effort.
     """
     eps = DEFAULT_COULOMB_WIDTH if coulomb_width is None else coulomb_width
-    layout = Layout(model.n, (eps,))
+    layout = Layout(model.n, (eps,), nb=model.nb)
     return reduce_recording(path, model.joint_names,
                             recording_rows(model, layout, False),
                             layout.bag_columns(False), topic, cutoff, split)
 
 
 def nominal_theta(model, coulomb_width=None):
-    """Return theta_0: the model's inertial parameters and drives (or 0)."""
+    """Return theta_0: the model's 10nb inertial parameters and 4n drives."""
     d = model_drives(model)
     d = np.zeros(N_DRIVE * model.n) if d is None else d.parameters()
     return np.concatenate([inertial_parameters(model), d])
@@ -121,14 +131,14 @@ def nominal_theta(model, coulomb_width=None):
 
 def fixed_parts(model, urdf_text=None, prior=False):
     """
-    (n, 10): nominal parameters of the parts rigidly attached to each link.
+    (nb, 10): nominal parameters of the parts rigidly attached to each body.
 
-    For a URDF model, each chain link's body is its own ``<inertial>``
-    plus the links joined to it by fixed joints (and locked off-chain
-    subtrees); this returns the latter (the total minus the link's own).
-    Zeros for other models.
+    For a URDF model, each body is its moving link's own ``<inertial>``
+    plus the links joined to it by fixed joints (and, on a chain, locked
+    off-chain subtrees); this returns the latter (the total minus the
+    link's own).  Zeros for other models.
     """
-    n = model.n
+    n = model.nb
     out = np.zeros((n, N_INERTIAL))
     report = (model.info or {}).get('urdf')
     if urdf_text is None or not report:
@@ -146,7 +156,7 @@ def fixed_parts(model, urdf_text=None, prior=False):
 
 @dataclass
 class Result:
-    """What :func:`identify` found; thetas are [pi (10n), drives (4n)]."""
+    """What :func:`identify` found; thetas are [pi (10nb), drives (4n)]."""
 
     model: object
     theta: np.ndarray
@@ -170,6 +180,7 @@ class Result:
     constants: str = 'none'     # 'none', 'given', 'identified'
     ratios: dict = field(default_factory=dict)   # bag: (K, explained)
     payload: dict = None        # the known mass's identified body
+    payload_link: str = None    # the link it is fixed to
     mass_excitation: np.ndarray = None   # constants.mass_excitation
     notes: list = field(default_factory=list)
     undetermined_k: list = field(default_factory=list)  # joint indices
@@ -180,7 +191,7 @@ class _Program:
 
     def __init__(self, layout, fixed, theta0, D, scales, mass=None):
         import cvxpy as cp
-        n = layout.n
+        n, nb = layout.n, layout.nb
         d = layout.size
         self.layout = layout
         self.R = cp.Parameter((d, d))
@@ -188,7 +199,7 @@ class _Program:
         self.sl = cp.Parameter(nonneg=True)
         self.sl_pay = cp.Parameter(nonneg=True)
         self.bodies = [ScaledBody(cp, *scales['bodies'][k])
-                       for k in range(n)]
+                       for k in range(nb)]
         self.dt = cp.Variable(N_DRIVE * n)
         parts = []
         for k, body in enumerate(self.bodies):
@@ -242,16 +253,16 @@ def _weights(recordings, layout, k0):
     d = layout.size
     x, *_ = np.linalg.lstsq(Aug[:d, :d], Aug[:d, d], rcond=1e-10)
     rms, rel = joint_stats(recordings, 'train', layout, 0, x, k0, k0)
-    ref = rms / np.maximum(rel, 1e-300)
+    ref = np.where(rel > 0, rms / np.maximum(rel, 1e-300), 0.0)  # NaN: 0
     return np.maximum(rms, np.maximum(1e-3 * ref, 1e-6))
 
 
 def _scales(model, theta0, D, layout, mass, Aall):
     """Typical sizes of the unknowns (``sdp``: solve in units of them)."""
-    n = model.n
-    pi0 = theta0[:N_INERTIAL * n].reshape(n, N_INERTIAL)
-    bodies = [body_scale(pi0[k]) for k in range(n)]
-    Dd = D[N_INERTIAL * n:layout.p_theta]
+    nb = model.nb
+    pi0 = theta0[:N_INERTIAL * nb].reshape(nb, N_INERTIAL)
+    bodies = [body_scale(pi0[k]) for k in range(nb)]
+    Dd = D[N_INERTIAL * nb:layout.p_theta]
     drives = 1.0 / np.maximum(Dd, 1e-12 * max(float(Dd.max()), 1e-300))
     payload = None
     if mass is not None:    # the payload's columns' norms (its prior)
@@ -261,12 +272,13 @@ def _scales(model, theta0, D, layout, mass, Aall):
     return {'bodies': bodies, 'drives': drives, 'payload': payload}
 
 
-def _reduce_all(model, layout, bags, known, topic, cutoff):
+def _reduce_all(model, layout, bags, known, topic, cutoff, frame=None):
     recordings = []
     for path, mass in [(b, None) for b in bags] + list(known):
         loaded = mass is not None
         train, held, info = reduce_recording(
-            path, model.joint_names, recording_rows(model, layout, loaded),
+            path, model.joint_names,
+            recording_rows(model, layout, loaded, frame),
             layout.bag_columns(loaded), topic, cutoff)
         info['held_samples'] = 0 if held is None else int(held.rows.max())
         recordings.append(Recording(str(path), train, held, info, mass))
@@ -280,7 +292,7 @@ def _ratios(recordings, layout, theta):
         red = rec.part('all')
         u = np.zeros(red.p)
         u[:layout.p_theta] = theta
-        if rec.loaded:      # the known mass as a point at the tip
+        if rec.loaded:      # the known mass as a point at its link
             u[layout.bag_columns(False)] = rec.mass
         out[rec.path] = effort_units.ratios(red, u, layout.drive_columns)
     return out
@@ -297,21 +309,6 @@ def _check_units(recordings, layout, theta0, model, mode, k_given, urdf):
     return out
 
 
-def _scale_pin(ratios, k0):
-    """
-    Weights c (sum 1) of the joints whose constants' mean fixes the scale.
-
-    The joints where the nominal model explains the effort (``effort``:
-    gravity-loaded joints) count by how well it does: the data fixes the
-    constants relative to each other, the nominal model's masses and
-    gravity their mean (``constants.fit_constants``).
-    """
-    c = np.zeros(len(k0))
-    for k, e in ratios.values():
-        c += np.where((e >= effort_units.MIN_EXPLAINED) & (k > 0), e, 0.0)
-    return c / c.sum()
-
-
 def _check_mass(recording, layout, sigma):
     """Raise IdentificationError when the known mass's torque never changes."""
     excited = mass_excitation(recording, layout, sigma)
@@ -326,39 +323,10 @@ def _check_mass(recording, layout, sigma):
     return excited
 
 
-def _determined(ratios, n):
-    """Joints whose effort follows the nominal model's rigid-body torque."""
-    out = np.zeros(n, dtype=bool)
-    for k, e in ratios.values():
-        out |= (e >= effort_units.MIN_EXPLAINED) & (k > 0)
-    return out
-
-
-def _initial_constants(ratios, n):
-    """
-    Each determined joint's ratio (weighted over the bags), else their mean.
-
-    Raises IdentificationError when no joint is determined.
-    """
-    K = np.zeros(n)
-    good = np.zeros(n)
-    for k, e in ratios.values():
-        use = (e >= effort_units.MIN_EXPLAINED) & (k > 0)
-        K += np.where(use, k * e, 0.0)
-        good += np.where(use, e, 0.0)
-    if not good.any():
-        raise IdentificationError(
-            f"{next(iter(ratios))}: no joint's effort follows the nominal "
-            f"model's torque, so the torque constants cannot be found "
-            f'(record the shoulder and elbow moving against gravity, or '
-            f'give the constants in the URDF)')
-    K = np.where(good > 0, K / np.maximum(good, 1e-300), np.nan)
-    return np.where(np.isnan(K), np.nanmean(K), K)
-
-
 def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
              coulomb_width=None, cutoff=None, urdf_text=None,
-             effort='torque', known_mass=None, urdf_label=None):
+             effort='torque', known_mass=None, urdf_label=None,
+             known_mass_link=None):
     """
     Identify ``model``'s parameters from the bag(s) at ``path``.
 
@@ -366,7 +334,9 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
     blocks from each).  ``effort`` 'torque' (N m) or 'current'
     (proportional to torque: the torque constants are identified, unless
     the nominal URDF gives them); ``known_mass`` None or (bag, kg): a
-    recording with that mass added at the tip.  Returns a
+    recording with that mass added at ``known_mass_link`` (default the
+    tip; ``payload.payload_frame``).  ``model`` is a chain or a whole
+    tree (``load_robot`` without a tip).  Returns a
     :class:`Result` whose ``model`` carries the identified inertials and
     ``drives`` the identified drive terms (with ``torque_constant``).
     Raises :class:`BagError` (or :class:`IdentificationError`) with one
@@ -383,16 +353,21 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
           else DEFAULT_COULOMB_WIDTH)
     widths = ((float(coulomb_width),) if coulomb_width is not None else
               (w0,) + tuple(w for w in WIDTHS if abs(w - w0) > 1e-12))
-    n = model.n
-    layout = Layout(n, widths, bool(known))
+    n, nb = model.n, model.nb
+    frame = None
+    if known:
+        from .payload import payload_frame
+        frame = payload_frame(model, known_mass_link)
+    layout = Layout(n, widths, bool(known), nb=nb)
     theta0 = nominal_theta(model)
     fixed = fixed_parts(model, urdf_text, prior=True)
-    recordings = _reduce_all(model, layout, bags, known, topic, cutoff)
+    recordings = _reduce_all(model, layout, bags, known, topic, cutoff,
+                             frame)
     mode = ('current' if estimate_k else 'given' if k_given is not None
             else 'torque')
     ratios = _check_units(recordings, layout, theta0, model, mode, k_given,
                           urdf_label)
-    k0 = (_initial_constants(ratios, n) if estimate_k else
+    k0 = (initial_constants(ratios, n) if estimate_k else
           k_given if k_given is not None else np.ones(n))
     sigma_e = _weights(recordings, layout, k0) / k0
     w = 1.0 / (sigma_e * k0)
@@ -414,18 +389,21 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
                        _scales(model, theta0, D, layout, mass, Aall), mass)
     lam, width, lam_errors, width_errors = _choose(
         program, recordings, layout, w, k0)
-    K, free = k0, None
+    K, free, notes = k0, None, []
     if estimate_k:
         # the joints whose effort the first fit's rigid-body torque explains
         Aall, _ = stacked(recordings, 'all', layout, width, w, k0)
         x = program.solve(Aall, lam, 'first fit')
-        free = _determined(ratios, n)
+        free = determined(ratios, n)
         if x is not None:
-            free |= _determined(_ratios(recordings, layout,
-                                        x[:layout.p_theta]), n)
+            free |= determined(_ratios(recordings, layout,
+                                       x[:layout.p_theta]), n)
+        from .payload import carrying
+        carried = carrying(model, frame[0]) if known else []
         K = fit_constants(
             recordings, layout, width, sigma_e, k0, lam, D, theta0, free,
-            None if known else _scale_pin(ratios, k0), mass)
+            scale_pins(ratios, model, carried, notes,
+                       frame[2] if known else None), mass)
         w = 1.0 / (sigma_e * K)
     Aall, _ = stacked(recordings, 'all', layout, width, w, K)
     x = program.solve(Aall, lam, 'final')
@@ -433,11 +411,11 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
         raise IdentificationError(f'{recordings[0].path}: the fit failed '
                                   f'(the solver found no solution)')
     eps = widths[width]
-    theta = _clean(x[:layout.p_theta], fixed, n)
+    theta = _clean(x[:layout.p_theta], fixed, nb, n)
     x[:layout.p_theta] = theta
     K_out = K if (estimate_k or k_given is not None) else None
-    drives = Drives.from_parameters(theta[N_INERTIAL * n:], eps, K_out)
-    ident = with_parameters(model, theta[:N_INERTIAL * n])
+    drives = Drives.from_parameters(theta[N_INERTIAL * nb:], eps, K_out)
+    ident = with_parameters(model, theta[:N_INERTIAL * nb])
     info_ = dict(model.info or {})
     info_['drives'] = drives
     ident = ident.replace(info=info_)
@@ -452,7 +430,8 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
         recordings=[(r.path, r.info) for r in recordings],
         undetermined_k=([] if free is None
                         else [int(j) for j in np.flatnonzero(~free)]),
-        mass_excitation=excited)
+        mass_excitation=excited, notes=notes,
+        payload_link=None if frame is None else frame[2])
     _report(result, recordings, layout, width, x, K, known, program)
     result.seconds = time.perf_counter() - start
     if validate is not None:
@@ -540,11 +519,11 @@ def _report(result, recordings, layout, width, x, K, known, program):
             + (' ...' if len(program.trouble) > 3 else ''))
 
 
-def _clean(theta, fixed, n):
-    """Project each link's own pseudo-inertia onto the PSD cone."""
+def _clean(theta, fixed, nb, n):
+    """Project each body's own pseudo-inertia onto the PSD cone."""
     from ..core.regressor import pseudo_inertia
     theta = theta.copy()
-    for k in range(n):
+    for k in range(nb):
         sl = slice(N_INERTIAL * k, N_INERTIAL * (k + 1))
         own = theta[sl] - fixed[k]
         J = pseudo_inertia(own)
@@ -555,10 +534,10 @@ def _clean(theta, fixed, n):
             own = np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], I[0, 0],
                             I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
             theta[sl] = own + fixed[k]
-    d = theta[N_INERTIAL * n:].reshape(n, N_DRIVE)
+    d = theta[N_INERTIAL * nb:].reshape(n, N_DRIVE)
     for col in (0, 1, 3):
         d[:, col] = np.maximum(d[:, col], 0.0)
-    theta[N_INERTIAL * n:] = d.ravel()
+    theta[N_INERTIAL * nb:] = d.ravel()
     return theta
 
 

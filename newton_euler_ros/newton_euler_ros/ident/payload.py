@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-Estimate a payload fixed to the tip from a recording.
+Estimate a payload fixed to a link (the tip by default) from a recording.
 
 The arm's model (identified inertials and drive terms) predicts what the
 drives need without the payload; the rest of the measured effort is the
@@ -24,13 +24,17 @@ payload's:
 with K the URDF's torque constants when the efforts are motor currents
 (``core.drives``: ``torque_constant``; 1 for torques).
 
-``Y_tip`` is the last link's ten columns of the torque regressor
-(``core.regressor``: parameters about the last link frame's origin, in its
-axes) and ``T`` the linear map of a body's ten parameters from the tip
-frame to the last link frame (the pseudo-inertia J transforms as
-X J X^T with X the 4x4 pose of the tip in the link frame, which is the
-model's ``tool``).  ``pi_p`` = (m, m c, I about the tip origin) in the tip
-frame.
+``Y_tip`` is the ten columns of the torque regressor of the body the
+payload's link is fixed to (``core.regressor``: parameters about that
+body's link frame origin, in its axes; the last link of a chain) and
+``T`` the linear map of a body's ten parameters from the payload's link
+frame to the body's link frame (the pseudo-inertia J transforms as
+X J X^T with X the 4x4 pose of the link in the body's frame: the model's
+``tool`` for the tip).  ``pi_p`` = (m, m c, I about the link origin) in
+the link's frame.  On a tree (``payload_frame``) the link is the single
+tip when there is one, else it must be named; only the joints that carry
+it (its body's ancestors, a mimic follower's through its leader) see the
+payload, and only they enter the fit.
 
 The samples come from the identification pipeline (``reduce``:
 resampled, zero-phase filtered, same filter on the effort), reduced to an
@@ -55,8 +59,10 @@ import numpy as np
 
 from .reduce import IdentificationError, reduce_recording
 from ..core.drives import model_drives
+from ..core.errors import NewtonEulerError
 from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
                               regressor_batch)
+from ..core.text import clip
 
 MASS_TOL = 0.05           # relative standard error of the mass
 MASS_ABS = 0.02           # kg: below this the payload is "no payload"
@@ -77,6 +83,80 @@ def _pi_from_pseudo(J):
     I = np.trace(Sigma) * np.eye(3) - Sigma  # noqa: E741
     return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], I[0, 0], I[0, 1],
                      I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
+class LinkError(NewtonEulerError, ValueError):
+    """No such link for a payload, or none named on a tree with several."""
+
+
+def _leaves(model):
+    """Links at the ends of the tree's branches that move (for messages)."""
+    report = (model.info or {}).get('urdf') or {}
+    parents = set((report.get('parent_links') or {}).values())
+    frames = model.link_frames or {}
+    return [lk for lk in report.get('chain_links', ())
+            if lk not in parents and frames.get(lk, (-1,))[0] >= 0]
+
+
+def _named_frame(model, link):
+    """(body, pose) of ``link`` in ``model``, or None."""
+    report = (model.info or {}).get('urdf') or {}
+    if link in (model.link_frames or {}):
+        return model.link_frames[link]
+    tool = np.asarray(model.tool)
+    if link == report.get('tip') and model.tool_body is not None:
+        return model.tool_body, tool
+    if link in report.get('tip_frames', {}):
+        return model.tool_body, tool @ report['tip_frames'][link]
+    if link in report.get('links', ()):     # a chain link's own frame
+        return list(report['links']).index(link), np.eye(4)
+    if link in report.get('base_frames', {}):
+        return -1, report['base_frames'][link]
+    return None
+
+
+def payload_frame(model, link=None, option='the link'):
+    """
+    Return (body, 4x4 pose in the body's link frame, link name).
+
+    The frame a payload (or a known mass) is fixed to: ``link``, or the
+    end effector (the tip) when None.  Raises :class:`LinkError` (one
+    line naming the candidates; ``option`` says how to name one) on a
+    tree with several tips and no link named, a link the model does not
+    have, or one fixed to the base.
+    """
+    report = (model.info or {}).get('urdf') or {}
+    if link is None:
+        if model.tool_body is None:
+            raise LinkError(
+                f'the tree below {report.get("base", "the base")!r} has '
+                f'several tips ({clip(", ".join(_leaves(model)), 600)}): '
+                f'name the link the mass is fixed to with {option}')
+        return model.tool_body, np.asarray(model.tool), report.get(
+            'tip') or 'the end effector'
+    found = _named_frame(model, link)
+    if found is None:
+        names = (list(model.link_frames or ()) or list(
+            report.get('links', ())) + [report.get('tip')])
+        raise LinkError(f'no link {clip(repr(link), 100)} in the model ('
+                        + clip(', '.join(str(x) for x in names), 300) + ')')
+    body, pose = found
+    if body < 0:
+        raise LinkError(f'link {link!r} is fixed to the base: a mass there '
+                        f"changes no joint's torque")
+    return int(body), np.asarray(pose, dtype=np.float64), link
+
+
+def carrying(model, body):
+    """Coordinates (indices) whose torque a mass on ``body`` changes."""
+    coord = {b: k for k, b in enumerate(model.independent)}
+    out = set()
+    b = body
+    while b >= 0:
+        lead = b if model.mimic[b] is None else model.mimic[b][0]
+        out.add(coord[lead])
+        b = model.parents[b]
+    return sorted(out)
 
 
 def tip_to_link(tool):
@@ -238,12 +318,22 @@ def _clip_psd(pi):
     return _pi_from_pseudo((V * np.maximum(lam, 0.0)) @ V.T)
 
 
-def estimate_payload(model, path, topic='/joint_states', cutoff=None):
-    """Return a :class:`PayloadEstimate` from the bag at ``path``."""
+def estimate_payload(model, path, topic='/joint_states', cutoff=None,
+                     link=None):
+    """
+    Return a :class:`PayloadEstimate` from the bag at ``path``.
+
+    The payload is fixed to ``link`` (default: the tip, see
+    :func:`payload_frame`); its centre of mass and inertia are given in
+    that link's frame.
+    """
     from ..core import inverse_dynamics_batch
     n = model.n
     drives = model_drives(model)
-    T = tip_to_link(model.tool)
+    body, pose, _ = payload_frame(model, link)
+    T = tip_to_link(pose)
+    cols = slice(N_INERTIAL * body, N_INERTIAL * (body + 1))
+    sees = carrying(model, body)
 
     def rows(q, qd, qdd, effort):
         tau = inverse_dynamics_batch(model, q, qd, qdd)
@@ -251,10 +341,12 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None):
             tau = tau + drives.torques(qd, qdd)
             # a motor current's torque: the torque constants of the URDF
             effort = drives.effort_to_torque(effort)
-        Y = regressor_batch(model, q, qd, qdd)[:, :, N_INERTIAL * (n - 1):]
-        return Y @ T, effort - tau
+        Y = regressor_batch(model, q, qd, qdd)[:, sees, cols]
+        return Y @ T, (effort - tau)[:, sees]
     red, _, info = reduce_recording(path, model.joint_names, rows,
-                                    N_INERTIAL, topic, cutoff, split=False)
+                                    N_INERTIAL, topic, cutoff, split=False,
+                                    outputs=len(sees))
+    n = len(sees)
     rows = np.maximum(red.rows, 1)
     A = red.stacked(np.ones(n))
     theta, *_ = np.linalg.lstsq(A[:, :-1], A[:, -1], rcond=1e-12)
@@ -300,7 +392,7 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None):
     est.duration = info['duration']
     est.residual_before = np.sqrt(red.sq_effort() / rows)
     est.residual_after = np.sqrt(red.sq_residuals(pi) / rows)
-    est.joint_names = list(model.joint_names)
+    est.joint_names = [model.joint_names[j] for j in sees]
     return est
 
 

@@ -18,17 +18,21 @@ The identification's least-squares problem, from reduced recordings.
 **Columns of a recording.**  Each recording is reduced once
 (``reduce.reduce_recording``) with the columns
 
-    [ Y (10n inertial + 4n drive, Coulomb at widths[0])
+    [ Y (10nb inertial + 4n drive, Coulomb at widths[0])
       | tanh(qd_j / w) for w in widths[1:]  (joint j's rows)
-      | Y_tip T (10, only for a recording with a known mass at the tip) ]
+      | Y_b T (10, only for a recording with a known mass at a link) ]
 
-against the raw effort e.  Every Coulomb width candidate is there, so
-that the width can be chosen on held-out blocks without reading the bag
-again; the known mass's parameters are the payload's, at the tip frame
+against the raw effort e, on a chain (nb = n) or a tree (nb bodies, a
+mimic follower's too; n coordinates, each with its drive terms).  Every
+Coulomb width candidate is there, so that the width can be chosen on
+held-out blocks without reading the bag again; the known mass's
+parameters are the payload's, in the frame of the link it is fixed to
+(``payload.payload_frame``: the tip by default), Y_b being the columns
+of the body carrying that link and T the map from that frame
 (``payload.tip_to_link``).
 
-**Unknowns** x = [theta (14n) | pi_p (10), when there is a known-mass
-recording].  For a width choice i, each joint's rows of a recording are
+**Unknowns** x = [theta (10nb + 4n) | pi_p (10), when there is a
+known-mass recording].  For a width choice i, each joint's rows of a recording are
 R_j (G x + h): G puts the Coulomb coefficient on the chosen width's
 column and the payload's parameters on the payload's; h the effort's
 coefficient, -K_j (the torque constant, 1 for torques; ``constants``
@@ -45,15 +49,41 @@ from ..core.regressor import N_DRIVE, N_INERTIAL, regressor_batch
 
 N_PAYLOAD = 10
 REST_SPEED = 0.02     # rad/s (m/s): a joint's slower rows are not fitted
+# ... or, for a joint whose velocity limit is below 10 x REST_SPEED (a
+# torso lift of 0.013 m/s), this fraction of its velocity limit
+REST_FRACTION = 0.1
+
+
+def rest_speeds(model):
+    """
+    Each coordinate's speed below which its rows are not fitted.
+
+    ``REST_SPEED``, or ``REST_FRACTION`` of the joint's URDF velocity
+    limit when that is lower: a slow joint (PR2's torso lifts at
+    0.013 m/s) would otherwise never count as moving.
+    """
+    limits = list(model.limits or ())
+    out = np.full(model.n, REST_SPEED)
+    for j, b in enumerate(model.independent):
+        v = (limits[b] if b < len(limits) else {}).get('velocity', 0.0)
+        if v > 0:
+            out[j] = min(REST_SPEED, REST_FRACTION * v)
+    return out
 
 
 class Layout:
-    """Positions of theta, K and the payload in x; columns of a bag."""
+    """
+    Positions of theta, K and the payload in x; columns of a bag.
 
-    def __init__(self, n, widths, payload=False):
+    ``n`` coordinates (rows, drive terms), ``nb`` bodies (default n; a
+    tree with mimic joints has more bodies than coordinates).
+    """
+
+    def __init__(self, n, widths, payload=False, nb=None):
         self.n = n
+        self.nb = n if nb is None else nb
         self.widths = tuple(float(w) for w in widths)
-        self.p_theta = (N_INERTIAL + N_DRIVE) * n
+        self.p_theta = N_INERTIAL * self.nb + N_DRIVE * n
         size = self.p_theta
         self.pay = slice(size, size + N_PAYLOAD) if payload else None
         size += N_PAYLOAD if payload else 0
@@ -66,11 +96,11 @@ class Layout:
 
     def coulomb(self, j):
         """Return joint j's Coulomb column in theta."""
-        return N_INERTIAL * self.n + N_DRIVE * j + 1
+        return N_INERTIAL * self.nb + N_DRIVE * j + 1
 
     def drive_columns(self, j):
         """Return joint j's four drive columns."""
-        a = N_INERTIAL * self.n + N_DRIVE * j
+        a = N_INERTIAL * self.nb + N_DRIVE * j
         return np.arange(a, a + N_DRIVE)
 
     def coefficients(self, j, width, loaded, k_const):
@@ -90,21 +120,29 @@ class Layout:
         return G, h
 
 
-def recording_rows(model, layout, loaded):
+def recording_rows(model, layout, loaded, frame=None):
     """
     Return the ``rows`` function of ``reduce.reduce_recording``.
 
+    ``loaded``: add the known mass's ten columns, at ``frame`` = (body,
+    pose of the mass's link in that body's frame), from
+    ``payload.payload_frame`` (default: the end effector).
+
     Each joint's fit keeps its rows where it moves at ``REST_SPEED`` or
-    faster: at rest, static friction holds any torque within +-F_s,
+    faster (``rest_speeds``: slower for a slow joint): at rest, static
+    friction holds any torque within +-F_s,
     which no model of (q, qd, qdd) predicts (on UR-like recordings with
     stops, fitting them tripled the error where joints move).
     """
     n = model.n
     extra = layout.widths[1:]
+    rest = rest_speeds(model)
     T = None
     if loaded:
-        from .payload import tip_to_link
-        T = tip_to_link(model.tool)
+        from .payload import payload_frame, tip_to_link
+        body, pose, _ = payload_frame(model) if frame is None else frame
+        T = tip_to_link(pose)
+        cols = slice(N_INERTIAL * body, N_INERTIAL * (body + 1))
 
     def rows(q, qd, qdd, effort):
         Y = regressor_batch(model, q, qd, qdd, drives=True,
@@ -116,11 +154,9 @@ def recording_rows(model, layout, loaded):
                 C[:, np.arange(n), i] = np.tanh(qd / w)
             parts.append(C)
         if T is not None:
-            tip = regressor_batch(model, q, qd, qdd)[:, :, N_INERTIAL
-                                                     * (n - 1):]
-            parts.append(tip @ T)
+            parts.append(Y[:, :, cols] @ T)
         return (np.concatenate(parts, axis=2), effort,
-                np.abs(qd) >= REST_SPEED)
+                np.abs(qd) >= rest)
     return rows
 
 
@@ -132,11 +168,11 @@ class Recording:
     train: object
     held: object
     info: dict
-    mass: float = None          # kg at the tip, or None
+    mass: float = None          # kg at the known-mass link, or None
 
     @property
     def loaded(self):
-        """Return True for a recording with a known mass at the tip."""
+        """Return True for a recording with a known mass."""
         return self.mass is not None
 
     def part(self, name):
@@ -202,7 +238,9 @@ def joint_stats(recordings, part, layout, width, x, k_const, k_effort):
     Per joint (rms N m, relative rms) of x over the recordings' ``part``.
 
     ``k_effort`` converts the effort to N m for the relative error's
-    reference (the torque constants, or ones).
+    reference (the torque constants, or ones).  The relative error of a
+    joint whose effort is zero throughout (a finger the driver reports
+    at 0) is NaN.
     """
     n = layout.n
     res = np.zeros(n)
@@ -219,4 +257,5 @@ def joint_stats(recordings, part, layout, width, x, k_const, k_effort):
             rows[j] += red.rows[j]
     rows = np.maximum(rows, 1)
     rms = np.sqrt(res / rows)
-    return rms, rms / np.maximum(np.sqrt(ref / rows), 1e-300)
+    ref = np.sqrt(ref / rows)
+    return rms, np.where(ref > 0, rms / np.maximum(ref, 1e-300), np.nan)

@@ -177,7 +177,7 @@ def decimation(rate, cutoff):
 
 
 def reduce_recording(path, joint_names, rows, columns, topic=DEFAULT_TOPIC,
-                     cutoff=None, split=True):
+                     cutoff=None, split=True, outputs=None):
     """
     Reduce a recording: return (train, held_out or None, info dict).
 
@@ -190,9 +190,11 @@ def reduce_recording(path, joint_names, rows, columns, topic=DEFAULT_TOPIC,
     ``BLOCK_S`` long, shorter for a recording under ten blocks (down to
     half a second), so that even a short one has a held-out part.
     ``info``: 'rate', 'cutoff', 'step' (the decimation), 'duration' (s)
-    and 'samples' (filtered).
+    and 'samples' (filtered).  ``outputs``: how many rows per sample
+    ``rows`` gives (default one per joint read; fewer when only some
+    joints matter, e.g. those carrying a payload).
     """
-    n = len(joint_names)
+    n = len(joint_names) if outputs is None else int(outputs)
     block_s = BLOCK_S
     if split:
         block_s = min(BLOCK_S, max(0.5, recording_seconds(path) / 10.0))

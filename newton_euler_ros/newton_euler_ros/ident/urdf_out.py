@@ -18,15 +18,21 @@ Write an identified model as the input URDF with its numbers replaced.
 Everything else of the input is kept (visuals, collisions, joints,
 limits, comments, other links): only
 
-- each chain link's ``<inertial>`` (its own body: the parts rigidly
-  attached to it by fixed joints keep their published inertials, and the
-  identified total of the chain body is their sum);
-- each chain joint's ``<dynamics damping=... friction=...>`` (viscous and
-  Coulomb friction; other attributes of an existing ``<dynamics>`` stay);
-- each chain joint's ``<ne:drive armature=... offset=...
+- each body's moving link's ``<inertial>`` (the chain's links, or every
+  moving joint's child link of a tree, a mimic follower's too; the parts
+  rigidly attached to it by fixed joints keep their published inertials,
+  and the identified total of the body is their sum);
+- each coordinate's joint's ``<dynamics damping=... friction=...>``
+  (viscous and Coulomb friction; other attributes of an existing
+  ``<dynamics>`` stay);
+- each coordinate's joint's ``<ne:drive armature=... offset=...
   coulomb_width=...>`` in the namespace ``core.drives.DRIVES_NS``
   (declared on ``<robot>``), which URDF parsers that do not know it
   ignore.
+
+A mimic follower's joint is left as it is: it is no coordinate, its
+friction and rotor inertia act through its leader's drive (identified as
+the leader's), and ``core.drives`` reads drive terms of coordinates only.
 
 Files are written atomically (:func:`atomic_write`): a temporary file in
 the same directory, flushed to disk, then renamed over the target.
@@ -166,21 +172,22 @@ def identified_urdf(text, model, theta, fixed, drives):
     """
     Return the URDF text of ``text`` with the identified parameters.
 
-    ``model`` is the nominal chain loaded from ``text`` (its
-    ``info['urdf']`` names the chain's links and joints); ``theta`` the
-    identified 10n inertial parameters (then optionally the drives);
-    ``fixed`` (n, 10) the parameters of the parts rigidly attached to each
-    link (``fit.fixed_parts``); ``drives`` a ``core.drives.Drives``.
+    ``model`` is the nominal chain or tree loaded from ``text`` (its
+    ``info['urdf']`` names the bodies' links); ``theta`` the identified
+    10nb inertial parameters (then optionally the drives); ``fixed``
+    (nb, 10) the parameters of the parts rigidly attached to each body
+    (``fit.fixed_parts``); ``drives`` a ``core.drives.Drives`` of the n
+    coordinates.
     """
     ET.register_namespace(DRIVES_PREFIX, DRIVES_NS)
     root = _parse_keep_comments(text)
     report = model.info['urdf']
     links = {el.get('name'): el for el in root.findall('link')}
     joints = {el.get('name'): el for el in root.findall('joint')}
-    n = model.n
-    for k in range(n):
+    for k in range(model.nb):
         pi = np.asarray(theta[N_INERTIAL * k:N_INERTIAL * (k + 1)])
         _set_inertial(links[report['links'][k]], pi - fixed[k])
-        _set_drive(joints[model.joint_names[k]], drives, k)
+    for j, name in enumerate(model.joint_names):
+        _set_drive(joints[name], drives, j)
     body = ET.tostring(root, encoding='unicode')
     return '<?xml version="1.0" encoding="utf-8"?>\n' + body + '\n'

@@ -260,6 +260,41 @@ def test_interrupted_is_130(command, files, tmp_path):
     assert not [p for p in os.listdir(tmp_path) if p.startswith('out')]
 
 
+# identify, replay and payload on the whole tree below the base (no --tip):
+# the Panda with its hand and its two fingers (one a mimic joint), which
+# the recording names at rest
+TREE = ['--base', BASE]
+TREE_CASES = {
+    'identify': (['{urdf}', '{bag}', *TREE, '-o', '{out}.urdf'],
+                 ['{urdf}', '{bag}', *TREE, '-o', '{out}.urdf',
+                  '--known-mass-link', 'panda_hand']),
+    'replay': (['{urdf}', '{bag}', *TREE, '--csv', '{out}.csv'],
+               ['{urdf}', '{missing}', *TREE, '--csv', '{out}.csv']),
+    # a tree with several tips: the payload's link must be named
+    'payload': (['{urdf}', '{bag}', *TREE, '--link', 'panda_hand'],
+                ['{urdf}', '{bag}', *TREE]),
+}
+
+
+@pytest.mark.parametrize('command', sorted(TREE_CASES))
+def test_a_tree_done_is_0(command, files, tmp_path):
+    proc = run([command, *fill(TREE_CASES[command][0], files,
+                               tmp_path / 'out')])
+    assert proc.returncode == 0, proc.stderr
+
+
+@pytest.mark.parametrize('command', sorted(TREE_CASES))
+def test_a_tree_wrong_input_is_2(command, files, tmp_path):
+    proc = run([command, *fill(TREE_CASES[command][1], files,
+                               tmp_path / 'out')])
+    assert proc.returncode == 2, proc.stderr
+    lines = [x for x in proc.stderr.splitlines()
+             if not x.startswith(('warning:', 'note:'))]
+    assert len(lines) == 1 and lines[0].startswith('newton-euler: error: '), \
+        proc.stderr
+    assert not [p for p in os.listdir(tmp_path) if p.startswith('out')]
+
+
 def test_the_rule_is_stated_once_in_docs_cli():
     root = os.path.dirname(PACKAGE_DIR)
     with open(os.path.join(root, 'docs', 'cli.md'), encoding='utf-8') as fh:
