@@ -79,7 +79,6 @@ Python API (kept stable for the tests that use it):
 - :func:`make_example` (out_dir, ...): every file above; returns paths.
 """
 import argparse
-import json
 import math
 import os
 import shutil
@@ -142,11 +141,11 @@ class RealArm:
 
     def to_json(self):
         """Return the truth as a JSON-ready dict."""
+        from .ident_example import jsonable
         return {'urdf': self.urdf, 'base': BASE, 'tip': TIP,
                 'joints': list(JOINTS), 'seed': self.seed,
                 'torque_constant': self.constants.tolist(),
-                'drives': {k: (v.tolist() if isinstance(v, np.ndarray)
-                               else v) for k, v in self.drives.items()}}
+                'drives': jsonable(self.drives)}
 
 
 def _realistic_wrists(root, rng):
@@ -410,9 +409,8 @@ def make_example(out_dir, seed=0, effort='current', seconds=60.0,
         paths[name] = path
         truth['runs'][name] = {'seconds': motion.seconds, 'payload': payload,
                                'pushes': list(push)}
-    paths['truth'] = os.path.join(out_dir, 'truth.json')
-    with open(paths['truth'], 'w', encoding='utf-8') as f:
-        json.dump(truth, f)
+    from .ident_example import write_truth
+    paths['truth'] = write_truth(out_dir, truth)
     return paths
 
 

@@ -67,7 +67,6 @@ recordings above, and ``truth.json`` (the perturbed URDF, the drives, the
 constants and payloads; for checking, not used by the commands).
 """
 import argparse
-import json
 import math
 import os
 import shutil
@@ -385,7 +384,7 @@ def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
                  effort='torque', validation_seconds=30.0, payload=True,
                  robot='baxter'):
     """Write the files the module docstring lists; return their paths."""
-    from .ident_example import perturb_urdf
+    from .ident_example import jsonable, perturb_urdf, write_truth
     os.makedirs(out_dir, exist_ok=True)
     rng = np.random.default_rng([seed, 1])
     spec = ROBOTS[robot]
@@ -409,14 +408,12 @@ def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
                motion(model, seed + 100 * k, secs, period), rate=rate,
                payload=load, effort=effort, seed=seed + k, robot=robot)
         paths[label] = path
-    paths['truth'] = os.path.join(out_dir, 'truth.json')
-    with open(paths['truth'], 'w', encoding='utf-8') as f:
-        json.dump({'urdf': truth, 'robot': robot, 'base': spec['base'],
-                   'effort': effort, 'joints': list(model.joint_names),
-                   'drives': {k: (v.tolist() if isinstance(v, np.ndarray)
-                                  else v) for k, v in drives.items()},
-                   'payload': {'link': spec['tool'], **PAYLOAD},
-                   'known_mass': {'link': spec['tool'], **KNOWN}}, f)
+    paths['truth'] = write_truth(out_dir, {
+        'urdf': truth, 'robot': robot, 'base': spec['base'],
+        'effort': effort, 'joints': list(model.joint_names),
+        'drives': jsonable(drives),
+        'payload': {'link': spec['tool'], **PAYLOAD},
+        'known_mass': {'link': spec['tool'], **KNOWN}})
     return paths
 
 

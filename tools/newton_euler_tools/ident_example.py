@@ -253,13 +253,24 @@ def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
             write_joint_states(path, stamps, names, q, qd, e,
                                storage=fmt)
             paths[label] = path
-    truth = {'urdf': truth_text, 'base': BASE, 'tip': TIP,
-             'drives': {k: (v.tolist() if isinstance(v, np.ndarray) else v)
-                        for k, v in drives.items()}}
-    paths['truth'] = os.path.join(out_dir, 'truth.json')
-    with open(paths['truth'], 'w', encoding='utf-8') as f:
-        json.dump(truth, f)
+    paths['truth'] = write_truth(out_dir, {
+        'urdf': truth_text, 'base': BASE, 'tip': TIP,
+        'drives': jsonable(drives)})
     return paths
+
+
+def jsonable(values):
+    """Return a dict of arrays and numbers as JSON takes it (lists)."""
+    return {k: (v.tolist() if isinstance(v, np.ndarray) else v)
+            for k, v in values.items()}
+
+
+def write_truth(out_dir, truth):
+    """Write an example's ``truth.json`` (for checking); return its path."""
+    path = os.path.join(out_dir, 'truth.json')
+    with open(path, 'w', encoding='utf-8') as f:
+        json.dump(truth, f)
+    return path
 
 
 def main(argv=None):

@@ -128,6 +128,18 @@ def _one_line(err):
     return text if len(text) <= 200 else text[:197] + '...'
 
 
+def _decode_one(deserialize, raw, msgtype, label, topic, counts):
+    """Decode one message (counted); BagError naming it if it cannot be."""
+    try:
+        msg = deserialize(raw, msgtype)
+    except Exception as err:  # noqa: BLE001
+        raise BagError(f'{label}: message {counts["messages"]} on '
+                       f'{topic!r} cannot be decoded (corrupt '
+                       f'bag?): {_one_line(err)}') from None
+    counts['messages'] += 1
+    return msg
+
+
 def _connections(connections, label, topic):
     conns = [c for c in connections if c.topic == topic]
     if not conns:
@@ -239,14 +251,8 @@ def _recovered(path, label, topic, why, counts, notes):
         for cid, logtime, raw in scan.messages():
             if cid not in wanted:
                 continue
-            try:
-                msg = ts.deserialize_cdr(raw, JOINT_STATE)
-            except Exception as err:  # noqa: BLE001
-                raise BagError(f'{label}: message {counts["messages"]} on '
-                               f'{topic!r} cannot be decoded (corrupt '
-                               f'bag?): {_one_line(err)}') from None
-            counts['messages'] += 1
-            yield logtime, msg
+            yield logtime, _decode_one(ts.deserialize_cdr, raw, JOINT_STATE,
+                                       label, topic, counts)
 
 
 def recovered_seconds(path):
@@ -309,14 +315,8 @@ def _decoded(reader, conns, label, topic, counts):
             raise BagError(f'{label}: the bag is corrupt or truncated '
                            f'after {counts["messages"]} messages: '
                            f'{_one_line(err)}') from None
-        try:
-            msg = reader.deserialize(raw, conn.msgtype)
-        except Exception as err:  # noqa: BLE001
-            raise BagError(f'{label}: message {counts["messages"]} on '
-                           f'{topic!r} cannot be decoded (corrupt '
-                           f'bag?): {_one_line(err)}') from None
-        counts['messages'] += 1
-        yield logtime, msg
+        yield logtime, _decode_one(reader.deserialize, raw, conn.msgtype,
+                                   label, topic, counts)
 
 
 class _Samples:
