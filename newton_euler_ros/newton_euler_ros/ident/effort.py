@@ -78,17 +78,48 @@ def ratios(red, u, drive_columns):
     return K, explained
 
 
+def sample_ratios(tau, effort, qd, width=0.02):
+    """
+    Per joint: (K, explained) of the ratio, from (m, n) samples.
+
+    What :func:`ratios` computes on a reduced recording, on samples
+    instead (``replay``: the model's torque ``tau`` against the
+    recorded ``effort`` at speeds ``qd``): both less their projection on
+    an offset, viscous and Coulomb (tanh of ``width``) column per joint.
+    """
+    n = tau.shape[1]
+    K = np.zeros(n)
+    explained = np.zeros(n)
+    for j in range(n):
+        v = qd[:, j]
+        Q, _ = np.linalg.qr(np.column_stack(
+            [np.ones_like(v), v, np.tanh(v / width)]))
+        t = tau[:, j] - Q @ (Q.T @ tau[:, j])
+        e = effort[:, j] - Q @ (Q.T @ effort[:, j])
+        te, tt, ee = float(t @ e), float(t @ t), float(e @ e)
+        if tt > 0 and ee > 0 and te != 0:
+            K[j] = tt / te
+            explained[j] = te * te / (tt * ee)
+    return K, explained
+
+
 def _cells(names, K, sel):
     return ', '.join(f'{names[j]} {K[j]:.3g}' for j in np.flatnonzero(sel))
 
 
-def check(label, names, K, explained, mode, urdf=None):
+#: what to do about currents taken for torques (``identify``'s option)
+CURRENT_FIX = "if the driver reports motor currents (UR's default), add " \
+    '--effort current'
+
+
+def check(label, names, K, explained, mode, urdf=None, fix=CURRENT_FIX):
     """
     Raise IdentificationError (one line) when the effort cannot be ``mode``.
 
     ``mode``: 'torque' (efforts in N m), 'given' (efforts times the
     URDF's torque constants, ``urdf`` names it) or 'current' (efforts
-    proportional to torque with unknown constants).
+    proportional to torque with unknown constants).  ``fix``: the end of
+    the line for efforts that are not torques.
     """
     counts = explained >= MIN_EXPLAINED
     negative = counts & (K < 0)
@@ -114,5 +145,4 @@ def check(label, names, K, explained, mode, urdf=None):
     raise IdentificationError(
         f'{label}: the efforts are not joint torques in N m: model torque '
         f'/ effort is {ratio} (least-squares ratio per joint, near 1 for '
-        f"torques); if the driver reports motor currents (UR's default), "
-        f'add --effort current')
+        f'torques); {fix}')
