@@ -398,7 +398,7 @@ def cmd_replay(args):
         _fail(f'{args.bag}: too short: nothing is left after filtering')
     model_tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
     current = drives is not None and drives.torque_constant is not None
-    _unit_warning(args, model, drives, model_tau, prep, current)
+    _unit_warning(args, model, drives, model_tau, prep)
     if current:     # compared in the effort's own unit
         model_tau = drives.torque_to_effort(model_tau)
     # the messages inside the filtered stretches (edges left out)
@@ -448,27 +448,15 @@ def cmd_replay(args):
 MOVING = 0.05       # rad/s (m/s): a joint moves faster than this
 
 
-def _unit_warning(args, model, drives, tau, prep, current):
-    """
-    Warn in one line when the efforts cannot be what the URDF says.
-
-    Torques, or currents times its torque constants: identify's test
-    (``ident.effort.check``) on the model's torque against the recorded
-    effort; the comparison is still printed.
-    """
+def _unit_warning(args, model, drives, tau, prep):
+    """Warn in one line when the efforts cannot be what the URDF says."""
     from .ident import effort as units
-    from .ident.reduce import IdentificationError
-    meas = drives.effort_to_torque(prep.effort) if current else prep.effort
-    K, explained = units.sample_ratios(tau, meas, prep.qd)
-    try:
-        units.check(args.bag, model.joint_names, K, explained,
-                    'given' if current else 'torque', args.model,
-                    fix="if the driver reports motor currents (UR's "
-                        'default), the URDF needs their torque_constant '
-                        '(identify --effort current writes it); the '
-                        'percentages below compare different units')
-    except IdentificationError as exc:
-        print(f'warning: {exc}', file=sys.stderr)
+    line = units.mismatch(args.bag, model.joint_names, tau, prep.effort,
+                          prep.qd, drives, args.model,
+                          units.URDF_FIX + '; the percentages below compare '
+                          'different units')
+    if line:
+        print(f'warning: {line}', file=sys.stderr)
 
 
 def _rms(err, mask=None):

@@ -177,6 +177,7 @@ def cmd_observe(args):
 
 def _observe(args):
     from .core.observer import observe_recording
+    from .ident import effort as units
     from .ident.bag import BagError, read_joint_states
 
     model, obs = _setup(args)
@@ -190,6 +191,12 @@ def _observe(args):
                      f'{args.topic!r} have no velocity (the observer needs '
                      f'joint velocities)')
     out = observe_recording(obs, rec.stamps, rec.q, rec.qd, rec.effort)
+    unit = units.recording_mismatch(
+        args.bag, model, rec.stamps, rec.q, rec.qd, rec.effort, args.robot,
+        units.URDF_FIX + '; the external torques and contacts below are '
+        'meaningless')
+    if unit:
+        print(f'warning: {unit}', file=sys.stderr)
     names = list(model.joint_names)
     if args.csv:
         _atomic_write(args.csv, lambda fh: _write_csv(fh, rec, out, names))

@@ -146,3 +146,53 @@ def check(label, names, K, explained, mode, urdf=None, fix=CURRENT_FIX):
         f'{label}: the efforts are not joint torques in N m: model torque '
         f'/ effort is {ratio} (least-squares ratio per joint, near 1 for '
         f'torques); {fix}')
+
+
+def mismatch(label, names, tau, effort, qd, drives, urdf, fix):
+    """
+    Return the one line saying the efforts are not what the URDF says.
+
+    ``tau`` the model's torque (N m) at the samples, ``effort`` the
+    recorded efforts there; the URDF's drives (``drives``, None: none)
+    say torques, or currents times their ``torque_constant``.  None when
+    the efforts can be that (:func:`check`, ``fix`` ending the line).
+    """
+    given = drives is not None and drives.torque_constant is not None
+    meas = drives.effort_to_torque(effort) if given else effort
+    K, explained = sample_ratios(tau, meas, qd)
+    try:
+        check(label, names, K, explained, 'given' if given else 'torque',
+              urdf, fix)
+    except IdentificationError as exc:
+        return str(exc)
+    return None
+
+
+def recording_mismatch(label, model, stamps, q, qd, effort, urdf, fix):
+    """
+    :func:`mismatch` on a recording (stamps, q, qd or None, effort).
+
+    The state filtered as identification filters it (``signals.prepare``),
+    the model's torque with its drive terms (``fit.predict``); None when
+    the efforts can be what the model's URDF says, or the recording is
+    too short to tell.
+    """
+    from ..core.drives import model_drives
+    from .fit import predict
+    from .signals import prepare
+    try:
+        prep = prepare(stamps, q, qd, effort)
+    except ValueError:              # too short or too slow to filter
+        return None
+    if prep is None:
+        return None
+    drives = model_drives(model)
+    tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
+    return mismatch(label, model.joint_names, tau, prep.effort, prep.qd,
+                    drives, urdf, fix)
+
+
+#: the end of the line for a command that uses the URDF as it is
+URDF_FIX = ("if the driver reports motor currents (UR's default), the URDF "
+            'needs their torque_constant (identify --effort current writes '
+            'it)')

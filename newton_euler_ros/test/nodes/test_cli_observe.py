@@ -217,9 +217,27 @@ def test_currents_with_torque_constants_give_the_torques_results(files):
     code, out, err = run(files['current_urdf'], files['current'], *args)
     assert code == 0, err
     assert 'torque constants 11, 13.5, 9, 4.2, 3.9, 3.1' in out
-    # read as N m, the currents are a wrong arm: contact all along
+    assert 'effort' not in err, err         # the units agree: no warning
+    code, _, err = run(files['urdf'], files['bag'], *args)
+    assert code == 0 and 'effort' not in err, err
+    # read as N m, the currents are a wrong arm: contact all along, and
+    # one line says why (the ratios it names are the torque constants)
     raw = observe_json(files['urdf'], files['current'], *args)
     assert raw['contact_fraction'] > 0.9
+    code, _, err = run(files['urdf'], files['current'], *args, '--json')
+    warned = [x for x in err.splitlines() if 'effort' in x]
+    assert code == 0 and len(warned) == 1, err
+    assert warned[0].startswith('warning: ') and \
+        'not joint torques' in warned[0], warned[0]
+    assert 'torque_constant' in warned[0], warned[0]
+    named = dict(cell.rsplit(' ', 1) for cell in warned[0].split(
+        'model torque / effort is ')[1].split(' (')[0].split(', '))
+    # far from 1; where the push (not in the model) does not dominate,
+    # the joint's torque constant
+    assert named and all(float(r) > 2.5 for r in named.values()), named
+    close = [name for name, r in named.items() if float(r) == pytest.approx(
+        CONSTANTS[files['model'].joint_names.index(name)], rel=0.05)]
+    assert len(close) >= 3, named
 
 
 def test_thresholds_from_a_free_recording_with_stops(tmp_path):
