@@ -296,7 +296,35 @@ def cmd_payload(args):
         print(json.dumps(est.parameters()))
         for line in est.undetermined_lines():
             print(f'warning: {line}', file=sys.stderr)
-        return 0
-    for line in est.summary_lines(link):
-        print(line)
+    else:
+        for line in est.summary_lines(link):
+            print(line)
+    _payload_unit_warning(args, model, est)
     return 0
+
+
+def _payload_unit_warning(args, model, est):
+    """
+    Warn in one line when the efforts cannot be what the URDF says.
+
+    Identify's check on the model with the payload found (a heavy payload
+    would otherwise pull the model's torque off the effort's scale): with
+    currents read as torques the fit finds no such payload, and the
+    efforts stay some torque constant off the model's torque.
+    """
+    from .feedforward_build import payload_model
+    from .ident import effort as units
+    from .ident.bag import read_joint_states
+    from .ident.payload import INERTIA_KEYS
+    try:
+        loaded = payload_model(model, est.mass, est.com,
+                               [est.inertia[a, b] for a, b in INERTIA_KEYS],
+                               args.link or '')
+    except ValueError:      # no payload the node could take: nothing to say
+        return
+    js = read_joint_states(args.bag, model.joint_names, args.topic)
+    line = units.recording_mismatch(
+        args.bag, loaded, js.stamps, js.q, js.qd, js.effort, args.model,
+        units.URDF_FIX + '; the payload found is meaningless')
+    if line:
+        print(f'warning: {line}', file=sys.stderr)

@@ -209,6 +209,15 @@ def test_payload_converts_the_current_through_the_constants(current,
     info['drives'] = info['drives'].with_torque_constant(None)
     wrong = estimate_payload(model.replace(info=info), current['known_mass'])
     assert abs(wrong.mass - 2.8) > 1.0
+    # the command says so in one line: the published URDF has no constants
+    code, _, err = run('payload', current['urdf'], current['known_mass'],
+                       *CHAIN, '--json')
+    warned = [x for x in err.splitlines() if 'effort' in x]
+    assert code == 0 and len(warned) == 1, err
+    assert warned[0].startswith('warning: ') and 'not joint torques' in \
+        warned[0] and 'payload found is meaningless' in warned[0], warned[0]
+    code, _, err = run('payload', out, current['known_mass'], *CHAIN)
+    assert code == 0 and 'effort' not in err, err
 
 
 def test_default_scale_from_the_nominal_model(current, tmp_path):
