@@ -35,15 +35,16 @@ half of the joints that count are outside ``TORQUE_BAND``, and as
 anything proportional to torque when a joint that counts has a negative
 ratio (the driver's sign convention, or joints swapped).
 
-Everything is computed from the reduced recording (``reduce.Reduced``):
-inner products of columns are inner products of their images by R.
+Here on the reduced recording (``reduce.Reduced``: inner products of
+columns are inner products of their images by R); on samples, and the
+decision, in ``core.effort_units``.
 """
 import numpy as np
 
 from .reduce import IdentificationError
-
-TORQUE_BAND = (0.4, 2.5)
-MIN_EXPLAINED = 0.5
+from ..core.effort_units import (CURRENT_FIX, describe,  # noqa: F401
+                                 MIN_EXPLAINED, sample_ratios, TORQUE_BAND,
+                                 URDF_FIX)
 
 
 def ratios(red, u, drive_columns):
@@ -78,74 +79,15 @@ def ratios(red, u, drive_columns):
     return K, explained
 
 
-def sample_ratios(tau, effort, qd, width=0.02):
-    """
-    Per joint: (K, explained) of the ratio, from (m, n) samples.
-
-    What :func:`ratios` computes on a reduced recording, on samples
-    instead (``replay``: the model's torque ``tau`` against the
-    recorded ``effort`` at speeds ``qd``): both less their projection on
-    an offset, viscous and Coulomb (tanh of ``width``) column per joint.
-    """
-    n = tau.shape[1]
-    K = np.zeros(n)
-    explained = np.zeros(n)
-    for j in range(n):
-        v = qd[:, j]
-        Q, _ = np.linalg.qr(np.column_stack(
-            [np.ones_like(v), v, np.tanh(v / width)]))
-        t = tau[:, j] - Q @ (Q.T @ tau[:, j])
-        e = effort[:, j] - Q @ (Q.T @ effort[:, j])
-        te, tt, ee = float(t @ e), float(t @ t), float(e @ e)
-        if tt > 0 and ee > 0 and te != 0:
-            K[j] = tt / te
-            explained[j] = te * te / (tt * ee)
-    return K, explained
-
-
-def _cells(names, K, sel):
-    return ', '.join(f'{names[j]} {K[j]:.3g}' for j in np.flatnonzero(sel))
-
-
-#: what to do about currents taken for torques (``identify``'s option)
-CURRENT_FIX = "if the driver reports motor currents (UR's default), add " \
-    '--effort current'
-
-
 def check(label, names, K, explained, mode, urdf=None, fix=CURRENT_FIX):
     """
     Raise IdentificationError (one line) when the effort cannot be ``mode``.
 
-    ``mode``: 'torque' (efforts in N m), 'given' (efforts times the
-    URDF's torque constants, ``urdf`` names it) or 'current' (efforts
-    proportional to torque with unknown constants).  ``fix``: the end of
-    the line for efforts that are not torques.
+    The line is :func:`core.effort_units.describe`'s.
     """
-    counts = explained >= MIN_EXPLAINED
-    negative = counts & (K < 0)
-    if negative.any():
-        raise IdentificationError(
-            f"{label}: the effort has the opposite sign of the model's "
-            f'torque on {_cells(names, K, negative)} (least-squares ratio '
-            f"model torque / effort): check the driver's sign convention "
-            f'and the joint names')
-    if mode == 'current' or counts.sum() == 0:
-        return
-    lo, hi = TORQUE_BAND
-    off = counts & ((K < lo) | (K > hi))
-    if off.sum() * 2 < counts.sum():
-        return
-    ratio = _cells(names, K, off)
-    if mode == 'given':
-        raise IdentificationError(
-            f'{label}: the efforts do not match the torque constants of '
-            f'{urdf}: model torque / (torque_constant x effort) is {ratio} '
-            f'(near 1 expected); fix or remove the torque_constant '
-            f'attributes')
-    raise IdentificationError(
-        f'{label}: the efforts are not joint torques in N m: model torque '
-        f'/ effort is {ratio} (least-squares ratio per joint, near 1 for '
-        f'torques); {fix}')
+    line = describe(label, names, K, explained, mode, urdf, fix)
+    if line is not None:
+        raise IdentificationError(line)
 
 
 def mismatch(label, names, tau, effort, qd, drives, urdf, fix):
@@ -160,12 +102,8 @@ def mismatch(label, names, tau, effort, qd, drives, urdf, fix):
     given = drives is not None and drives.torque_constant is not None
     meas = drives.effort_to_torque(effort) if given else effort
     K, explained = sample_ratios(tau, meas, qd)
-    try:
-        check(label, names, K, explained, 'given' if given else 'torque',
-              urdf, fix)
-    except IdentificationError as exc:
-        return str(exc)
-    return None
+    return describe(label, names, K, explained,
+                    'given' if given else 'torque', urdf, fix)
 
 
 def recording_mismatch(label, model, stamps, q, qd, effort, urdf, fix):
@@ -190,9 +128,3 @@ def recording_mismatch(label, model, stamps, q, qd, effort, urdf, fix):
     tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
     return mismatch(label, model.joint_names, tau, prep.effort, prep.qd,
                     drives, urdf, fix)
-
-
-#: the end of the line for a command that uses the URDF as it is
-URDF_FIX = ("if the driver reports motor currents (UR's default), the URDF "
-            'needs their torque_constant (identify --effort current writes '
-            'it)')

@@ -41,6 +41,7 @@ from .common import ConfigurationError, qos_profile, QUIET, seconds
 from ..core import NewtonEulerError
 from ..core import observer as momentum
 from ..core.effects import friction_torque
+from ..core.effort_units import EffortMonitor
 from ..core.text import clip
 from ..joint_inputs import InputRejected
 
@@ -57,6 +58,9 @@ class NodeObserver:
         """
         self.node, self.params = node, params
         self.ff = self.obs = self.state = self.contact = None
+        #: the efforts' unit checked against the model, window by window
+        self.units = None
+        self.said_units = None
         self.status = 'waiting for the first JointState'
         self.said = set()
         self.rejected = 0
@@ -133,7 +137,19 @@ class NodeObserver:
         self._torque.name = list(model.joint_names)
         self._links = self._end_effectors(model)
         self.ff, self.obs, self.state = ff, obs, state
+        self._units_for(obs)
         return obs
+
+    def _units_for(self, obs):
+        """Check the efforts' unit against this observer's model."""
+        mode = 'torque' if obs.torque_constant is None else 'given'
+        old = self.units
+        if old is not None and old.mode == mode and \
+                old.names == list(obs.model.joint_names):
+            return
+        source = self.params['robot_file'] or 'the robot description'
+        self.units = EffortMonitor(obs.model.joint_names, mode, 'observer',
+                                   source)
 
     def _end_effectors(self, model):
         """Return (link, message, buffer) of each observer.end_effectors."""
@@ -210,6 +226,13 @@ class NodeObserver:
                                          ff.last_qd, effort)
         if what == momentum.DUPLICATE:
             return None
+        units = self.units
+        if units.due(stamp, ff.last_qd):
+            torque = effort if obs.torque_constant is None else \
+                effort * obs.torque_constant
+            # the model's torque: what the drives apply plus the residual
+            if units.add(stamp, torque + r, torque, ff.last_qd):
+                self._units_checked(units)
         if self._links:
             for link, _, F in self._links:
                 momentum.external_wrench(obs, ff.last_q, r, out=F,
@@ -225,6 +248,19 @@ class NodeObserver:
                                     self.state.allowance)
         self.status = 'running'
         return r, F, before, now
+
+    def _units_checked(self, units):
+        """Say a window's verdict on the efforts' unit when it changes."""
+        verdict = units.verdict
+        if verdict == self.said_units:
+            return
+        self.said_units = verdict
+        log = self.node.get_logger()
+        if verdict is not None:
+            log.warning(verdict)
+        elif units.windows > 1:
+            log.info('observer: the efforts now match the model (least-'
+                     'squares ratio per joint)')
 
     def observe(self, ff, msg, reject):
         """
@@ -278,11 +314,19 @@ class NodeObserver:
         contact, state = self.contact, self.state
         running = self.status == 'running'
         in_contact = bool(contact is not None and contact.in_contact)
+        units = self.units
+        verdict = None if units is None else units.verdict
+        if verdict is not None:
+            message = clip(verdict, 500)
+        elif running:
+            message = 'contact' if in_contact else 'no contact'
+        else:
+            message = self.status
         status = DiagnosticStatus(
-            level=DiagnosticStatus.OK if running else DiagnosticStatus.WARN,
+            level=DiagnosticStatus.OK if running and verdict is None
+            else DiagnosticStatus.WARN,
             name=self.node.get_fully_qualified_name() + ': observer',
-            message=('contact' if in_contact else 'no contact')
-            if running else self.status)
+            message=message)
         status.values = [
             KeyValue(key='state', value=self.status),
             KeyValue(key='in_contact', value=str(in_contact).lower()),
@@ -297,8 +341,20 @@ class NodeObserver:
             KeyValue(key='thresholds', value=repr(
                 list(self.params['observer.thresholds']))),
             KeyValue(key='static_friction', value=repr(
-                self.params['observer.static_friction']))]
+                self.params['observer.static_friction'])),
+            KeyValue(key='effort_units', value=_units_text(units))]
         return status
+
+
+def _units_text(units):
+    """Return the diagnostics' word on the efforts' unit."""
+    if units is None or units.windows == 0:
+        return 'not checked yet (10 s of motion needed)'
+    if units.verdict is not None:
+        return 'not what the URDF says'
+    unit = 'N m per torque_constant' if units.mode == 'given' else 'N m'
+    plural = 's' if units.windows != 1 else ''
+    return f'{unit} (checked on {units.windows} window{plural} of motion)'
 
 
 def _per_joint(name, values, model):
