@@ -65,6 +65,13 @@ def identified_urdf(truth, seed=0):
     return ET.tostring(root, encoding='unicode')
 
 
+def write_identified(path, arm, seed=0):
+    """Write the identified URDF of ``arm`` (a ``RealArm``); return path."""
+    with open(path, 'w', encoding='utf-8') as fh:
+        fh.write(identified_urdf(arm.to_json(), seed))
+    return str(path)
+
+
 def main(argv=None):
     """Write the identified URDF; 0, or 2 with one line on bad input."""
     parser = argparse.ArgumentParser(

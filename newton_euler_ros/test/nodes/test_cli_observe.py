@@ -252,12 +252,10 @@ def test_thresholds_from_a_free_recording_with_stops(tmp_path):
     shoulder's Coulomb friction.
     """
     from newton_euler_tools import current_arm_example as arm_example
-    from newton_euler_tools.current_arm_model import identified_urdf
+    from newton_euler_tools.current_arm_model import write_identified
     from newton_euler_tools.current_arm_motions import point_to_point
     arm = arm_example.real_arm(3)
-    urdf = str(tmp_path / 'arm.urdf')
-    with open(urdf, 'w', encoding='utf-8') as fh:
-        fh.write(identified_urdf(arm.to_json(), 3))
+    urdf = write_identified(tmp_path / 'arm.urdf', arm, 3)
     bags = []
     for k in (1, 2):
         bags.append(str(tmp_path / f'free_{k}'))

@@ -49,13 +49,11 @@ SEED = 3
 @pytest.fixture(scope='module')
 def recording(tmp_path_factory):
     from newton_euler_tools import current_arm_example as example
-    from newton_euler_tools.current_arm_model import identified_urdf
+    from newton_euler_tools.current_arm_model import write_identified
     from newton_euler_tools.current_arm_motions import point_to_point
     tmp = tmp_path_factory.mktemp('units')
     arm = example.real_arm(SEED)
-    identified = str(tmp / 'identified.urdf')
-    with open(identified, 'w', encoding='utf-8') as fh:
-        fh.write(identified_urdf(arm.to_json(), SEED))
+    identified = write_identified(tmp / 'identified.urdf', arm, SEED)
     bag = str(tmp / 'moving')
     example.record(arm, bag, point_to_point(SEED, 25.0, dwell=(0.1, 0.4)),
                    seed=SEED)

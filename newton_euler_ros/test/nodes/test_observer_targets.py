@@ -66,16 +66,14 @@ def observe_json(*args):
 @pytest.fixture(scope='module')
 def recordings(tmp_path_factory):
     from newton_euler_tools import current_arm_example as example
-    from newton_euler_tools.current_arm_model import identified_urdf
+    from newton_euler_tools.current_arm_model import write_identified
     from newton_euler_tools.current_arm_motions import (concatenate,
                                                         holding,
                                                         point_to_point,
                                                         random_pushes)
     tmp = tmp_path_factory.mktemp('targets')
     arm = example.real_arm(SEED)
-    urdf = str(tmp / 'arm.urdf')
-    with open(urdf, 'w', encoding='utf-8') as fh:
-        fh.write(identified_urdf(arm.to_json(), SEED))
+    urdf = write_identified(tmp / 'arm.urdf', arm, SEED)
     runs = {}
     for k in range(1, 11):          # the first, a minute, for thresholds
         motion = point_to_point(SEED + 100 * k, 60.0 if k == 1 else 30.0,
