@@ -18,8 +18,8 @@
     newton-euler observe MODEL.urdf BAG --base LINK --tip LINK
                          [--csv OUT.csv] [--plot OUT.png] [--json]
                          [--topic T] [--gain K] [--thresholds T [T ...]]
-                         [--static-friction R] [--hysteresis H]
-                         [--damping L] [--max-gap S]
+                         [--static-friction R] [--no-rest-reference]
+                         [--hysteresis H] [--damping L] [--max-gap S]
                          [--payload-mass M] [--payload-com X Y Z]
 
 The same observer as inverse_dynamics_node's ``observer.*`` parameters
@@ -87,6 +87,11 @@ def register(subparsers):
                      "up to R x each joint's Coulomb friction (URDF "
                      '<dynamics friction>) above the thresholds; 0: none '
                      '(default 1.5)')
+    obs.add_argument('--no-rest-reference', dest='rest_reference',
+                     action='store_false',
+                     help='do not feel pushes on the resting arm within the '
+                          'friction band (the rest reference, '
+                          'docs/observer.md)')
     obs.add_argument('--hysteresis', type=float, default=0.5,
                      help='release below this fraction of the threshold '
                           '(default 0.5)')
@@ -160,6 +165,7 @@ def _setup(args):
                                damping=args.damping,
                                thresholds=args.thresholds,
                                hysteresis=args.hysteresis,
+                               rest_reference=args.rest_reference,
                                **drive_options(model, args.static_friction))
     except ValueError as exc:
         raise _Usage(str(exc).replace('payload.', '--payload-')) from None

@@ -35,7 +35,7 @@ import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core import observer as momentum
-from newton_euler_ros.core import observer_wrench
+from newton_euler_ros.core import observer_contact, observer_wrench
 from newton_euler_ros.core.dynamics import (coriolis_matrix, gravity_torques,
                                             jacobian, mass_matrix)
 from newton_euler_ros.core.kernels import (F_TOOL, run_jacobian,
@@ -93,7 +93,7 @@ def _separate_arithmetic(D, C, g, qd, tau, lost, armature, gain, dt, restart,
 # reference-counting runtime; uncached: numba's cache does not tell two
 # compilations of one function with other options apart)
 _dls_then = njit(observer_wrench._dls_wrench.py_func)
-_contact_then = njit(momentum._contact.py_func)
+_contact_then = njit(observer_contact._contact.py_func)
 
 
 class SeparatePasses:
@@ -140,8 +140,8 @@ class SeparatePasses:
             self.F[:] = 0.0
         return self.F
 
-    def contact(self, contact, r):
-        """``contact_step`` as it was."""
+    def contact(self, contact, r, _t=None):
+        """``contact_step`` as it was (before the rest reference)."""
         obs = self.obs
         now = _contact_then(r, obs.thresholds, obs.hysteresis,
                             obs._no_allowance, contact.active)
@@ -211,13 +211,13 @@ def measure(model, number, repeat):
             clock[0] += 1e-3
             r = step(state, clock[0])
             wrench(r)
-            contact_fn(contact, r)
+            contact_fn(contact, r, clock[0])
         return update
 
     new_update = updater(
         lambda s, t: observer_step(obs, s, t, q, qd, tau)[0],
         lambda r: external_wrench(obs, q, r, out=F),
-        lambda c, r: contact_step(obs, c, r), obs)
+        lambda c, r, t: contact_step(obs, c, r, None, t, q, qd), obs)
     old_update = updater(
         lambda s, t: old.step(s, t, q, qd, tau), lambda r: old.wrench(q, r),
         old.contact, old.obs)

@@ -84,6 +84,8 @@ from .drives import DEFAULT_COULOMB_WIDTH
 from .errors import DynamicsInputError
 from .kernels import NONFINITE, run_momentum_terms, SIZE
 from .kernels._jit import ENTRY, uses_kernels
+from .observer_contact import (contact_step, ContactState,  # noqa: F401
+                               initial_contact, RestState)
 from .observer_thresholds import (beyond_friction,  # noqa: F401
                                   suggest_thresholds)
 from .observer_wrench import external_wrench, felt_directions  # noqa: F401
@@ -182,26 +184,6 @@ _step_strict = strict_entry(_step, PACKED, VEC, VEC, VEC, VEC, F8, MAT, MAT,
                             MAT, VEC, VEC, VEC, MAT)
 
 
-@njit(**ENTRY)
-def _contact(r, on, hysteresis, allowance, active):
-    """
-    Per-joint hysteresis; True when any joint is in contact.
-
-    On above ``on + allowance``, off below ``hysteresis * on +
-    allowance``: the static friction allowance is not scaled (a joint
-    left at the edge of its friction band after a push is released).
-    """
-    any_active = False
-    for i in range(r.shape[0]):
-        x = abs(r[i]) - allowance[i]
-        if active[i]:
-            active[i] = x > hysteresis * on[i]
-        else:
-            active[i] = x > on[i]
-        any_active |= active[i]
-    return any_active
-
-
 # ---------------------------------------------------------------------------
 # configuration and state
 
@@ -253,6 +235,9 @@ class MomentumObserver:
     hysteresis : a joint in contact is released when |r| falls below
         this fraction of its threshold, plus the allowance
         (0 < hysteresis <= 1).
+    rest_reference : also test, once the whole arm rests, each residual's
+        change from the value it settled to (``observer_contact.py``): a
+        push on a resting arm is felt within the friction band.
     ws : a :class:`Workspace` of the model (a new one by default); not
         shared with another thread.
 
@@ -261,7 +246,8 @@ class MomentumObserver:
     def __init__(self, model, gain=50.0, *, max_gap=0.1, drive_torque=None,
                  armature=None, damping=0.01, thresholds=10.0,
                  hysteresis=0.5, torque_constant=None, static_friction=None,
-                 friction_width=DEFAULT_COULOMB_WIDTH, ws=None):
+                 friction_width=DEFAULT_COULOMB_WIDTH, rest_reference=True,
+                 ws=None):
         n = model.n
         self.model = model
         self.n = n
@@ -303,6 +289,7 @@ class MomentumObserver:
         if not (0.0 < self.hysteresis <= 1.0):
             raise ValueError(f'hysteresis: must be in (0, 1], got '
                              f'{hysteresis!r}')
+        self.rest_reference = bool(rest_reference)
         self.J = np.zeros((6, n))
         self.p = self._buf[_P]          # momentum of the last sample
         self.beta = self._buf[_BETA]    # its known torque
@@ -319,7 +306,8 @@ class MomentumObserver:
         observer_step(self, state, 0.0, z, z, z)
         observer_step(self, state, 1e-3, z, z, z)
         external_wrench(self, z, state.r)
-        contact_step(self, initial_contact(self), state.r, state.allowance)
+        contact_step(self, initial_contact(self), state.r, state.allowance,
+                     0.0, z, z)
 
 
 def drive_terms(model):
@@ -402,25 +390,11 @@ class ObserverState:
         return self.friction[0]
 
 
-@dataclass
-class ContactState:
-    """Per-joint contact flags, the overall flag and the contact count."""
-
-    active: np.ndarray
-    in_contact: bool = False
-    count: int = 0          # contacts begun (false -> true)
-
-
 def initial_state(obs):
     """Return a state before any sample: the first one starts the sum."""
     n = obs.n
     return ObserverState(np.zeros(n), np.zeros(n), np.zeros(n),
                          np.zeros((2, n)))
-
-
-def initial_contact(obs):
-    """Return a contact state with no joint in contact."""
-    return ContactState(np.zeros(obs.n, dtype=np.bool_))
 
 
 def observer_step(obs, state, t, q, qd, tau):
@@ -507,23 +481,6 @@ def _vector(name, x, n):
     return x
 
 
-def contact_step(obs, contact, r, allowance=None):
-    """
-    Update ``contact`` from the residual; return whether in contact.
-
-    ``allowance``: the state's static friction allowance
-    (``state.allowance``), added to every threshold; None: none.
-    """
-    if allowance is None:
-        allowance = obs._no_allowance
-    now = _contact(r, obs.thresholds, obs.hysteresis, allowance,
-                   contact.active)
-    if now and not contact.in_contact:
-        contact.count += 1
-    contact.in_contact = bool(now)
-    return contact.in_contact
-
-
 @dataclass
 class ObserverRecording:
     """The observer over a recording, one row per sample."""
@@ -537,6 +494,10 @@ class ObserverRecording:
     restarts: int = 0
     skipped: int = 0                # rows with non-finite input
     allowance: np.ndarray = None    # (m, n) static friction allowance
+    q: np.ndarray = None            # (m, n) the input, for the thresholds
+    qd: np.ndarray = None           # (m, n) (``suggest_thresholds``)
+    rest_reference: bool = False    # whether its contact test was on
+    max_gap: float = 0.1
 
 
 def observe_recording(obs, T, Q, QD, TAU):
@@ -560,7 +521,9 @@ def observe_recording(obs, T, Q, QD, TAU):
     Q, QD, TAU = arrays
     out = ObserverRecording(T.copy(), np.zeros((m, n)), np.zeros((m, 6)),
                             np.zeros(m, dtype=np.bool_), [],
-                            allowance=np.zeros((m, n)))
+                            allowance=np.zeros((m, n)), q=Q, qd=QD,
+                            rest_reference=obs.rest_reference,
+                            max_gap=obs.max_gap)
     state, contact = initial_state(obs), initial_contact(obs)
     F = np.zeros(6)
     for k in range(m):
@@ -568,7 +531,8 @@ def observe_recording(obs, T, Q, QD, TAU):
             r, what = observer_step(obs, state, T[k], Q[k], QD[k], TAU[k])
             if what != DUPLICATE:
                 external_wrench(obs, Q[k], r, out=F)
-                contact_step(obs, contact, r, state.allowance)
+                contact_step(obs, contact, r, state.allowance, T[k], Q[k],
+                             QD[k])
         except DynamicsInputError:
             out.skipped += 1
             what = 'skipped'

@@ -25,6 +25,8 @@ import math
 
 import numpy as np
 
+from .observer_contact import rest_deviations
+
 #: suggested threshold = this x the free-motion peak beyond the allowance:
 #: the peaks of other recordings of like motion reached up to 1.6 x that
 #: of the one suggesting (model error depends on the motion)
@@ -45,10 +47,23 @@ def suggest_thresholds(recording, factor=FACTOR):
     least): what the contact test compares with the threshold, so a like
     recording stays below them by that factor.  Stops are allowed for,
     whatever their length; a contact during the recording would be taken
-    for noise.
+    for noise.  When the recording's observer had the rest reference on,
+    a joint's threshold is raised where the change from the rest value
+    that the rest test compares with it (:func:`.observer_contact.
+    rest_deviations`, run with the thresholds above) was larger than
+    their 1/``factor``.
     """
     peak = beyond_friction(recording).max(axis=0, initial=0.0)
-    return np.array([_round_up(factor * x) for x in peak])
+    out = np.array([_round_up(factor * x) for x in peak])
+    if not recording.rest_reference or recording.q is None:
+        return out
+    # the rest reference's test, with these thresholds (its calm test
+    # depends on them): what it compares with them, likewise
+    held = rest_deviations(recording.t, recording.q, recording.qd,
+                           recording.residual, out, recording.max_gap)
+    rest = held.max(axis=0, initial=0.0)
+    return np.maximum(out, [_round_up(factor * x) if x > 0.0 else 0.0
+                            for x in rest])
 
 
 def _round_up(x):

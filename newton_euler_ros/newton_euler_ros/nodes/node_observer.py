@@ -113,7 +113,8 @@ class NodeObserver:
             damping=p['observer.damping'],
             thresholds=_per_joint('observer.thresholds',
                                   p['observer.thresholds'], model),
-            hysteresis=_at_most_one(p['observer.hysteresis']), **options)
+            hysteresis=_at_most_one(p['observer.hysteresis']),
+            rest_reference=p['observer.rest_reference'], **options)
         if obs.torque_constant is not None and 'constants' not in self.said:
             self.said.add('constants')
             self.node.get_logger().info(
@@ -129,6 +130,8 @@ class NodeObserver:
             state.restarts = old.restarts
         if self.contact is None or self.contact.active.shape != (model.n,):
             self.contact = momentum.initial_contact(obs)
+        else:                   # a new model: its residual settles anew
+            self.contact.rest = momentum.RestState(model.n)
         urdf = model.info.get('urdf') if isinstance(model.info, dict) \
             else None
         base = (p['base_link'] or (urdf or {}).get('base')
@@ -245,7 +248,8 @@ class NodeObserver:
                                          out=self._wrench_out)
         before = self.contact.in_contact
         now = momentum.contact_step(obs, self.contact, r,
-                                    self.state.allowance)
+                                    self.state.allowance, stamp, ff.last_q,
+                                    ff.last_qd)
         self.status = 'running'
         return r, F, before, now
 
@@ -342,8 +346,19 @@ class NodeObserver:
                 list(self.params['observer.thresholds']))),
             KeyValue(key='static_friction', value=repr(
                 self.params['observer.static_friction'])),
+            KeyValue(key='rest_reference', value=_rest_text(
+                self.params['observer.rest_reference'], contact)),
             KeyValue(key='effort_units', value=_units_text(units))]
         return status
+
+
+def _rest_text(enabled, contact):
+    """Return the diagnostics' word on the rest reference."""
+    if not enabled:
+        return 'off'
+    rest = None if contact is None else contact.rest
+    return 'armed (the arm rests)' if rest is not None and rest.armed \
+        else 'waiting for the arm to rest'
 
 
 def _units_text(units):
