@@ -241,6 +241,7 @@ def _intervals(t, flag):
 def _summary(args, model, obs, rec, out):
     """Return what the command found, as a dict (the --json object)."""
     from .core.observer import beyond_friction, suggest_thresholds
+    from .core.observer_thresholds import rest_changes
     t = out.t
     resting = (np.abs(rec.qd) < obs.friction_width).all(axis=1)
     constant = obs.torque_constant
@@ -257,6 +258,8 @@ def _summary(args, model, obs, rec, out):
         'peak': np.abs(out.residual).max(axis=0).tolist(),
         'rms': np.sqrt((out.residual ** 2).mean(axis=0)).tolist(),
         'peak_beyond_friction': beyond_friction(out).max(axis=0).tolist(),
+        'rest_reference': bool(obs.rest_reference),
+        'peak_rest_change': rest_changes(out).tolist(),
         'suggested_thresholds': suggest_thresholds(out).tolist(),
         'contacts': int(out.contacts),
         'contact_fraction': float(out.contact.mean()),
@@ -284,18 +287,20 @@ def _table(s):
                          f'{k:.4g}' for k in s['torque_constant'])
                      + ' (N m per effort unit)')
     lines.append(f'{"joint":<24}{"threshold":>10}{"friction":>10}'
-                 f'{"max |tau_ext|":>14}{"beyond":>9}{"rms":>9}'
-                 f'{"suggested":>10}')
+                 f'{"max |tau_ext|":>14}{"beyond":>9}{"at rest":>9}'
+                 f'{"rms":>9}{"suggested":>10}')
     for j, name in enumerate(s['joints']):
         lines.append(
             f'{name:<24}{s["thresholds"][j]:>10.3g}'
             f'{s["friction_allowance"][j]:>10.3g}{s["peak"][j]:>14.3g}'
-            f'{s["peak_beyond_friction"][j]:>9.3g}{s["rms"][j]:>9.3g}'
+            f'{s["peak_beyond_friction"][j]:>9.3g}'
+            f'{s["peak_rest_change"][j]:>9.3g}{s["rms"][j]:>9.3g}'
             f'{s["suggested_thresholds"][j]:>10.3g}')
     lines.append('friction = static friction allowed for at rest (N m or '
-                 'N); beyond = max |tau_ext| beyond it; suggested = 2 x '
-                 'beyond (valid when the recording is free motion, no '
-                 'contact)')
+                 'N); beyond = max |tau_ext| beyond it; at rest = max '
+                 "change from the settled arm's rest value (the rest "
+                 'reference); suggested = 2 x the larger (valid when the '
+                 'recording is free motion, no contact)')
     for note in s['notes']:
         lines.append(f'note: {note}')
     return lines

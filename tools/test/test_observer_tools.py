@@ -12,8 +12,9 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The observer's bench and example recording run end to end."""
-from newton_euler_tools import bench_observer, observer_example
+"""The observer's bench, example recording and targets run end to end."""
+from newton_euler_tools import (bench_observer, observer_example,
+                                observer_targets)
 import numpy as np
 import pytest
 
@@ -56,3 +57,15 @@ def test_example_bag_holds_the_push(tmp_path):
     other.mkdir()
     assert observer_example.main(['planar_2r', str(other)]) == 2
     assert observer_example.main(['no_such_robot', bag]) == 2
+
+
+def test_targets_table_runs(tmp_path, capsys):
+    """One seed, with and without the rest reference: the printed table."""
+    assert observer_targets.main(['--seeds', '4', '--out',
+                                  str(tmp_path)]) == 0
+    out = capsys.readouterr().out.splitlines()
+    row = out[2].split()
+    assert row[0] == '4' and out[-1].startswith('all'), out
+    # pushes within 0.2 s, with / without: counts of 10
+    assert 0 <= int(row[1]) <= 10 and 0 <= int(row[3]) <= 10, out
+    assert (tmp_path / 'seed_4' / 'pushed').is_dir()

@@ -62,7 +62,7 @@ REST_TRAVEL = 1e-4
 #: s the residuals must stay calm before their rest values are taken
 SETTLE = 0.3
 #: calm: the low-passed residual's range within this x the threshold
-CALM = 0.5
+CALM = 1.0
 #: s, the time constant of that low pass
 SMOOTH = 0.05
 #: s a change beyond the threshold must last to be a contact

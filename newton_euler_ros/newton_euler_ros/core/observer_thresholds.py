@@ -48,22 +48,38 @@ def suggest_thresholds(recording, factor=FACTOR):
     recording stays below them by that factor.  Stops are allowed for,
     whatever their length; a contact during the recording would be taken
     for noise.  When the recording's observer had the rest reference on,
-    a joint's threshold is raised where the change from the rest value
-    that the rest test compares with it (:func:`.observer_contact.
-    rest_deviations`, run with the thresholds above) was larger than
-    their 1/``factor``.
+    likewise with the largest change from the rest value
+    (:func:`rest_changes`) where it is larger.
     """
-    peak = beyond_friction(recording).max(axis=0, initial=0.0)
-    out = np.array([_round_up(factor * x) for x in peak])
-    if not recording.rest_reference or recording.q is None:
-        return out
-    # the rest reference's test, with these thresholds (its calm test
-    # depends on them): what it compares with them, likewise
-    held = rest_deviations(recording.t, recording.q, recording.qd,
-                           recording.residual, out, recording.max_gap)
-    rest = held.max(axis=0, initial=0.0)
+    out = _band_thresholds(recording, factor)
+    rest = rest_changes(recording, factor)
     return np.maximum(out, [_round_up(factor * x) if x > 0.0 else 0.0
                             for x in rest])
+
+
+def rest_changes(recording, factor=FACTOR):
+    """
+    Return per joint the largest change from the rest value (n,).
+
+    What the rest reference's test compares with the thresholds
+    (:func:`.observer_contact.rest_deviations`, a change held for its
+    confirmation time), run with the thresholds the allowance test
+    alone suggests (its calm test depends on them); zeros when the
+    recording's observer had the rest reference off.
+    """
+    n = recording.residual.shape[1]
+    if not recording.rest_reference or recording.q is None:
+        return np.zeros(n)
+    held = rest_deviations(recording.t, recording.q, recording.qd,
+                           recording.residual,
+                           _band_thresholds(recording, factor),
+                           recording.max_gap)
+    return held.max(axis=0, initial=0.0)
+
+
+def _band_thresholds(recording, factor):
+    peak = beyond_friction(recording).max(axis=0, initial=0.0)
+    return np.array([_round_up(factor * x) for x in peak])
 
 
 def _round_up(x):

@@ -40,6 +40,7 @@ from newton_euler_ros.core.drives import DRIVES_NS  # noqa: E402
 import reference_dynamics as ref  # noqa: E402
 from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
                          NodeProcess, Probe)
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Bool  # noqa: E402
 
@@ -87,12 +88,14 @@ def graph(tmp_path_factory):
                       '-p', 'observer.enabled:=true',
                       '-p', 'observer.gain:=50.0',
                       '-p', f'observer.thresholds:=[{THRESHOLD}]',
-                      '-p', 'observer.contact_period:=0.2')
+                      '-p', 'observer.contact_period:=0.2',
+                      '-p', 'diagnostics_period:=0.2')
     node = NodeProcess(cmd, domain, os.path.join(tmp, 'node.log'))
     probe = Probe(domain)
     g = {'node': node, 'probe': probe, 'model': model,
          'ext': probe.collect(JointState, f'{NODE}/external_torque', 2000),
          'contact': probe.collect(Bool, f'{NODE}/contact', 2000),
+         'diagnostics': probe.collect(DiagnosticArray, '/diagnostics'),
          'js': probe.publisher(JointState, 'joint_states', 1000)}
     ok = probe.spin_until(
         lambda: g['js'].get_subscription_count() > 0 and all(
@@ -129,6 +132,11 @@ def test_resting_in_the_friction_band_is_no_contact_and_a_push_is(graph):
     resting = len(sent)
     g['probe'].spin_for(0.3)                        # a ~/contact repeat
     at_rest = [m.data for m in g['contact']]
+    # the arm has rested and settled: the rest reference is armed
+    rest = [kv.value for a in g['diagnostics'][-2:] for st in a.status
+            if st.name.endswith(': observer') for kv in st.values
+            if kv.key == 'rest_reference']
+    assert rest and rest[-1] == 'armed (the arm rests)', rest
     for k in range(60):                             # then pushed
         # the drives hold the pose against the push: tau - J^T F_ext
         send(2000 + k, gravity + HELD - push)
