@@ -252,13 +252,6 @@ class ContactState:
     count: int = 0          # contacts begun (false -> true)
     rest: RestState = None  # the rest reference (its own flags)
 
-    @property
-    def joints(self):
-        """Per joint, in contact by either test."""
-        if self.rest is None:
-            return self.active.copy()
-        return self.active | self.rest.active
-
 
 def initial_contact(obs):
     """Return a contact state with no joint in contact."""
