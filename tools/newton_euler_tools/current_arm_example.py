@@ -71,8 +71,9 @@ Python API (kept stable for the tests that use it):
 
 - :func:`real_arm` (seed) -> :class:`RealArm`, the truth;
 - :func:`excitation`, :func:`point_to_point`, :func:`holding`,
-  :func:`concatenate` (``current_arm_motions``): motions, callables
-  ``f(t) -> (q, qd, qdd)`` with a ``seconds`` attribute;
+  :func:`concatenate`, :func:`held_then_moving` (``current_arm_motions``):
+  motions, callables ``f(t) -> (q, qd, qdd)`` with a ``seconds``
+  attribute;
 - :func:`record` (arm, path, motion, ...): one recording, with an
   optional payload and pushes (:func:`random_pushes`); returns the true
   signals at the messages (torque, friction, external torque);
@@ -89,8 +90,8 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from .current_arm_motions import (CENTRE, concatenate, excitation,  # noqa
-                                  HALF_RANGE, holding, point_to_point,
-                                  random_pushes, SPEED)
+                                  HALF_RANGE, held_then_moving, holding,
+                                  point_to_point, random_pushes, SPEED)
 
 UR5 = 'ur_description/urdf/ur5_robot.urdf'
 BASE, TIP = 'base_link', 'tool0'
@@ -398,8 +399,7 @@ def make_example(out_dir, seed=0, effort='current', seconds=60.0,
     if 'rest' in runs:
         plan.append(('rest', holding(seed), None, ()))
     if 'pushed' in runs and pushes > 0:
-        motion = concatenate(holding(seed + 7, poses=3),
-                             point_to_point(seed + 7, 20.0))
+        motion = held_then_moving(seed + 7)
         plan.append(('pushed', motion, None,
                      random_pushes(seed, motion.seconds, pushes)))
     for k, (name, motion, payload, push) in enumerate(plan):

@@ -109,11 +109,12 @@ def _moves(start, targets, durations, dwells):
                                   0.0)
         return q, qd, qdd
     f.seconds = float(total)
+    f.end = poses[-1].copy()
     return f
 
 
 def point_to_point(seed=0, seconds=40.0, dwell=(0.1, 0.4), few=0.0,
-                   start=0.5, reverse=1.0):
+                   start=0.5, reverse=1.0, begin=None):
     """
     Point-to-point moves with stops and reversals, about ``seconds`` long.
 
@@ -122,10 +123,12 @@ def point_to_point(seed=0, seconds=40.0, dwell=(0.1, 0.4), few=0.0,
     else stays on its side (it may then creep slowly).  A move lasts as
     its largest distance allows at the joints' :data:`SPEED` and ends in
     a stop drawn from ``dwell`` (s); a fraction ``few`` of the moves move
-    only one to three joints (the others stay at rest).
+    only one to three joints (the others stay at rest).  ``begin``: the
+    pose it starts from (default :data:`CENTRE`).
     """
     rng = np.random.default_rng([seed, 2])
-    pose = CENTRE.copy()
+    first = CENTRE.copy() if begin is None else np.array(begin, dtype=float)
+    pose = first.copy()
     targets, durations, dwells = [], [], []
     t = start
     side = rng.choice([-1.0, 1.0], 6)
@@ -147,11 +150,12 @@ def point_to_point(seed=0, seconds=40.0, dwell=(0.1, 0.4), few=0.0,
         dwells.append(w)
         pose = target
         t += d + w
-    inner = _moves(CENTRE, targets, durations, dwells)
+    inner = _moves(first, targets, durations, dwells)
 
     def g(tt):
         return inner(np.asarray(tt, dtype=np.float64) - start)
     g.seconds = float(t)
+    g.end = inner.end
     return g
 
 
@@ -172,7 +176,18 @@ def holding(seed=0, poses=5, hold=(4.0, 8.0)):
 
 
 def concatenate(*motions):
-    """One motion after the other (each starts where the last ended)."""
+    """
+    One motion after the other; each must start where the last ended.
+
+    ValueError if one does not (the arm would jump between two samples).
+    """
+    for k in range(1, len(motions)):
+        was = motions[k - 1](np.array([motions[k - 1].seconds]))[0][0]
+        now = motions[k](np.array([0.0]))[0][0]
+        if np.abs(now - was).max() > 1e-9:
+            raise ValueError(f'concatenate: motion {k} starts at '
+                             f'{now.tolist()}, not where motion {k - 1} '
+                             f'ended ({was.tolist()})')
     starts = np.cumsum([0.0] + [m.seconds for m in motions])
 
     def f(t):
@@ -185,7 +200,14 @@ def concatenate(*motions):
                 o[sel] = v
         return tuple(out)
     f.seconds = float(starts[-1])
+    f.end = getattr(motions[-1], 'end', None)
     return f
+
+
+def held_then_moving(seed):
+    """Three poses held 4-8 s each, then 20 s of point-to-point moves."""
+    hold = holding(seed, poses=3)
+    return concatenate(hold, point_to_point(seed, 20.0, begin=hold.end))
 
 
 def random_pushes(seed, seconds, count, newtons=(20.0, 100.0),

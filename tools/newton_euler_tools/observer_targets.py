@@ -45,7 +45,7 @@ def recordings(seed, out_dir):
     """Write the arm's identified URDF and its 11 recordings; return them."""
     from . import current_arm_example as example
     from .current_arm_model import write_identified
-    from .current_arm_motions import (concatenate, holding, point_to_point,
+    from .current_arm_motions import (held_then_moving, point_to_point,
                                       random_pushes)
     arm = example.real_arm(seed)
     urdf = write_identified(os.path.join(out_dir, 'arm.urdf'), arm, seed)
@@ -56,8 +56,7 @@ def recordings(seed, out_dir):
         path = os.path.join(out_dir, f'free_{k}')
         runs[f'free_{k}'] = (path, example.record(arm, path, motion,
                                                   seed=seed * 1000 + k))
-    motion = concatenate(holding(seed + 7, poses=3),
-                         point_to_point(seed + 7, 20.0))
+    motion = held_then_moving(seed + 7)
     pushes = random_pushes(seed, motion.seconds, 10)
     path = os.path.join(out_dir, 'pushed')
     runs['pushed'] = (path, example.record(arm, path, motion, pushes=pushes,

@@ -328,3 +328,20 @@ def test_the_generator_models_what_it_says(tmp_path):
     held = np.abs(rec['friction'][rest]).max(axis=0)
     assert np.all(held > 0.2 * np.asarray(arm.drives['coulomb']))
     assert os.path.isdir(tmp_path / 'hold')
+
+
+def test_the_motions_never_jump():
+    # a position-controlled arm moves between its samples: every motion,
+    # the held-then-moving one of the pushed recordings included, changes
+    # q by at most its peak speed between two 100 Hz samples (a jump
+    # would be a step in gravity torque, taken for a push at rest)
+    from newton_euler_tools.current_arm_motions import (
+        concatenate, held_then_moving, holding, point_to_point, SPEED)
+    for motion in (held_then_moving(7), point_to_point(7, 20.0),
+                   holding(7, poses=3)):
+        t = np.arange(0.0, motion.seconds, 0.01)
+        q, qd, _ = motion(t)
+        assert np.all(np.abs(np.diff(q, axis=0)) <= 1.01 * SPEED * 0.01)
+        assert np.all(np.abs(qd) <= 1.01 * SPEED)
+    with pytest.raises(ValueError, match='motion 1 starts at'):
+        concatenate(holding(7, poses=3), point_to_point(7, 20.0))

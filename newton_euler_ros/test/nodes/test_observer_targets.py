@@ -144,7 +144,7 @@ def test_pushes_reported_and_no_contact_at_rest(recordings, thresholds):
     assert sum(r[2] is not None for r in rows) >= 8, rows
     assert sum(r[3] is not None for r in rows) >= 3, rows   # not vacuous
     # from the onset: the rest reference reports pushes on the resting
-    # arm early (without it, 4 of these 10 within 0.2 s)
+    # arm early (without it, 5 of these 10 within 0.2 s)
     soon = sum(r[2] is not None and r[2] <= 0.2 for r in rows)
     _, without = observed(recordings['urdf'], path, thresholds,
                           rest_reference=False)
@@ -152,4 +152,4 @@ def test_pushes_reported_and_no_contact_at_rest(recordings, thresholds):
     before = sum(r[2] is not None and r[2] <= 0.2 for r in plain)
     print(f'within 0.2 s of onset: {soon} of 10 ({before} without the rest '
           f'reference)')
-    assert soon >= 6 and soon > before, (rows, plain)
+    assert soon >= 7 and soon > before, (rows, plain)
