@@ -26,7 +26,9 @@ thresholds suggested from one free-motion minute with stops, then
 - contacts in 9 other free-motion recordings (30 s each, with stops);
 - the share of the un-pushed rest reported in contact;
 - 10 pushes of 20-100 N on the tool (half-sines of 0.4-1.2 s, the arm
-  resting or moving): how many are reported within 0.2 s of their onset;
+  resting or moving): how many are reported within 0.2 s of their onset
+  (and, after the table, when the others were and what the arm was
+  doing as they began);
 
 once with the rest reference (the default) and once without
 (``rest_reference=False``: the threshold and the static friction
@@ -113,6 +115,35 @@ def pushes_felt(data, rec, out):
     return rows, float(out.contact[resting & ~pushed].mean())
 
 
+def onset(data, rec, push):
+    """
+    Say what the arm was doing when ``push`` began, in a few words.
+
+    Resting (seconds since it stopped, until it moves), moving, and the
+    gap in the messages at the onset if one was longer than 0.1 s.
+    """
+    _, truth = data['runs']['pushed']
+    t, i = truth_at(truth, rec)
+    resting = (truth['qd'][i] == 0.0).all(axis=1)
+    k = int(np.searchsorted(t, push['start']))
+    words = []
+    if k < t.size and k > 0 and t[k] - t[k - 1] > 0.1:
+        words.append(f'in a {t[k] - t[k - 1]:.2f} s gap of the messages, '
+                     f'{t[k] - push["start"]:.2f} s of it after the onset')
+    k = min(k, t.size - 1)
+    if resting[k]:
+        a = b = k
+        while a > 0 and resting[a - 1]:
+            a -= 1
+        while b < t.size - 1 and resting[b + 1]:
+            b += 1
+        words.append(f'resting, {push["start"] - t[a]:.2f} s after its '
+                     f'stop and {t[b] - push["start"]:.2f} s before it moves')
+    else:
+        words.append('moving')
+    return ', '.join(words)
+
+
 def evaluate(data, rest_reference=True):
     """Return the targets of one seed's recordings, a dict of figures."""
     from newton_euler_ros.core.observer_thresholds import suggest_thresholds
@@ -125,8 +156,11 @@ def evaluate(data, rest_reference=True):
     rec, out = observed(data['urdf'], data['runs']['pushed'][0], thresholds,
                         rest_reference)
     rows, at_rest = pushes_felt(data, rec, out)
+    late = [(n, after, onset(data, rec, p))
+            for (n, _, after), p in zip(rows, data['pushes'])
+            if after is None or after > 0.2]
     return {'thresholds': thresholds.tolist(), 'free_with_contact': free,
-            'rows': rows, 'at_rest': at_rest,
+            'rows': rows, 'at_rest': at_rest, 'late': late,
             'soon': sum(r[2] is not None and r[2] <= 0.2 for r in rows)}
 
 
@@ -148,6 +182,7 @@ def main(argv=None):
                         'recordings (default: a temporary one)')
     args = parser.parse_args(argv)
     total = {True: [0, 0, []], False: [0, 0, []]}
+    late = []
     print('seed  pushes within 0.2 s of onset   free recordings with '
           'contact   un-pushed rest in contact')
     print('      rest ref. / without          rest ref. / without       '
@@ -158,6 +193,7 @@ def main(argv=None):
             os.makedirs(folder, exist_ok=True)
             data = recordings(seed, folder)
             got = {on: evaluate(data, on) for on in (True, False)}
+            late += [(seed, *x) for x in got[True]['late']]
             for on, e in got.items():
                 total[on][0] += e['soon']
                 total[on][1] += e['free_with_contact']
@@ -171,6 +207,10 @@ def main(argv=None):
           f'{"":13}{total[True][1]:>2} / {total[False][1]:<2} of {9 * n}'
           f'{"":15}at most {max(total[True][2]):.1%} / '
           f'{max(total[False][2]):.1%}')
+    print('\npushes not reported within 0.2 s of onset (rest reference on):')
+    for seed, newtons, after, words in late:
+        said = 'not reported' if after is None else f'{after:.3f} s'
+        print(f'  seed {seed}: {newtons} N, {said} (onset: {words})')
     return 0
 
 

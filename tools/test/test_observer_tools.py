@@ -65,7 +65,11 @@ def test_targets_table_runs(tmp_path, capsys):
                                   str(tmp_path)]) == 0
     out = capsys.readouterr().out.splitlines()
     row = out[2].split()
-    assert row[0] == '4' and out[-1].startswith('all'), out
+    assert row[0] == '4' and out[3].startswith('all'), out
     # pushes within 0.2 s, with / without: counts of 10
     assert 0 <= int(row[1]) <= 10 and 0 <= int(row[3]) <= 10, out
+    # then one line for each of the others, with the arm at its onset
+    late = [x for x in out if x.startswith('  seed 4: ')]
+    assert len(late) == 10 - int(row[1]), out
+    assert all('(onset: ' in x for x in late), out
     assert (tmp_path / 'seed_4' / 'pushed').is_dir()

@@ -43,9 +43,12 @@ start, and both look like a push.  The joints of a move start and stop
 together, and the one that travels furthest shows it first: a joint
 that creeps to its stop below the position's resolution, or breaks away
 before its own position moves, is covered by the others.  Any motion,
-a gap in the stamps or a stamp going backwards ends the rest; the band
-test alone applies until the arm has settled again.  Measured on the
-current-sensing example in docs/observer.md.
+a stamp going backwards, or a gap in the stamps (longer than the
+observer's ``max_gap`` before the rest values are taken, than
+``EXPIRE`` after) ends the rest; the band test alone applies until the
+arm has settled again.  A shorter gap on the settled arm, its pose
+unchanged, keeps the rest values: nothing moved the friction held.
+Measured on the current-sensing example in docs/observer.md.
 """
 from dataclasses import dataclass
 import math
@@ -115,7 +118,9 @@ def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, band,
     n = r.shape[0]
     dt = t - flags[_T_PREV]
     flags[_T_PREV] = t
-    moving = not (0.0 < dt <= max_gap)      # a gap or a stamp backwards
+    # a stamp backwards, or a gap the armed rest does not span
+    moving = not (0.0 < dt <= max_gap
+                  or (flags[_ARMED] != 0.0 and 0.0 < dt <= EXPIRE))
     for i in range(n):
         if abs(qd[i]) > REST_SPEED or abs(q[i] - anchor[i]) > REST_TRAVEL:
             moving = True

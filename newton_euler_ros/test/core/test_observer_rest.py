@@ -20,8 +20,10 @@ observer would give it: a resting arm holds a friction of any value in
 its band (here 6 N m and -5 N m, the allowance 9 N m, far above the
 1 N m thresholds), a push adds to it.  Once the whole arm has rested
 and settled, a push smaller than the band is a contact within CONFIRM
-plus a sample; without the rest reference it is not.  Any motion, a position creeping beyond
-REST_TRAVEL, or a gap ends the rest; a push under way when the rest
+plus a sample; without the rest reference it is not.  Any motion, a
+position creeping beyond REST_TRAVEL, a stamp going backwards or a gap
+longer than EXPIRE ends the rest (a shorter one on the settled arm does
+not: a push begun in it is reported); a push under way when the rest
 value is taken is no contact after its release for longer than EXPIRE;
 and the thresholds suggested from a free recording cover the changes a
 settled residual shows.
@@ -106,11 +108,40 @@ def test_motion_creep_and_gaps_end_the_rest(model):
     q[:, 0] = np.arange(m) * DT * 5.0 * REST_TRAVEL     # 5 x per second
     _, out, _ = run(model, r, q=q)
     assert not out.any()
-    # a gap of 0.5 s just before the push: the rest starts again there
+    # a gap longer than EXPIRE just before the push: the rest starts
+    # again there
     t = np.arange(m) * DT
-    t[290:] += 0.5
+    t[290:] += EXPIRE + 0.1
     _, out, _ = run(model, r, t=t)
     assert not out[:300 + int(SETTLE / DT)].any()
+    # and a stamp going backwards
+    t = np.arange(m) * DT
+    t[290:] -= 0.5
+    _, out, _ = run(model, r, t=t)
+    assert not out[:300 + int(SETTLE / DT)].any()
+
+
+def test_a_shorter_gap_on_the_settled_arm_keeps_its_rest(model):
+    # messages lost for 0.5 s (within EXPIRE) while the settled arm stays
+    # where it was, a push beginning in the gap: reported CONFIRM after
+    # the messages resume, as if none had been lost
+    m = 400
+    t = np.arange(m) * DT
+    t[290:] += 0.5
+    r = pushed(m, 0.0, 0.0)
+    r[t >= 3.0, 0] += 2.5
+    _, out, c = run(model, r, t=t)
+    assert not out[t < 3.0].any()
+    first = t[np.argmax(out)]
+    assert out.any() and first <= t[290] + CONFIRM + 2 * DT
+    assert c.count == 1
+    # the same gap before the arm settled: the rest starts again after it
+    t = np.arange(m) * DT
+    t[20:] += 0.5
+    r = pushed(m, 0.0, 0.0)
+    r[t >= 0.6, 0] += 2.5
+    _, out, _ = run(model, r, t=t)
+    assert not out.any()
 
 
 def test_a_push_under_way_when_the_rest_value_is_taken(model):
