@@ -176,6 +176,42 @@ def _number(el, attr, where, label, minimum=None):
     return value
 
 
+#: the attributes of <ne:drive>
+DRIVE_ATTRIBUTES = ('armature', 'offset', 'coulomb_width', 'torque_constant')
+
+
+def _one(el, tag, where, label):
+    """The joint's element ``tag``, or None; given twice is an error."""
+    found = el.findall(tag)
+    if len(found) > 1:
+        shown = tag.replace(f'{{{DRIVES_NS}}}', f'{DRIVES_PREFIX}:')
+        raise RobotFileError(f'{label}: {where}: <{shown}> given '
+                             f'{len(found)} times (once at most)')
+    return found[0] if found else None
+
+
+def _placed(root, label):
+    """Refuse a <ne:drive> that is not a robot-level joint's child."""
+    tag = f'{{{DRIVES_NS}}}drive'
+    own = sum(len(j.findall(tag)) for j in root.findall('joint'))
+    if own == sum(1 for _ in root.iter(tag)):
+        return
+    parents = {child: el for el in root.iter() for child in el}
+    for el in root.iter(tag):
+        up = parents[el]
+        if up.tag == 'joint' and parents.get(up) is root:
+            continue
+        path = []
+        while up is not None:
+            name = up.get('name')
+            path.append(f'<{up.tag}' + (f' name={name!r}>' if name else '>'))
+            up = parents.get(up)
+        raise RobotFileError(
+            f'{label}: <{DRIVES_PREFIX}:drive> inside '
+            f'{" ".join(reversed(path))}: it is read only as a child of '
+            f'the <robot> element\'s own <joint>')
+
+
 def read_drives(root, joint_names, label='robot_description', prior=False,
                 notes=None):
     """
@@ -187,6 +223,7 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
     identification): negative friction is kept, listed in ``notes``.
     """
     joints = {el.get('name'): el for el in root.findall('joint')}
+    _placed(root, label)
     n = len(joint_names)
     vals = {k: np.zeros(n) for k in FIELDS}
     width = np.full(n, DEFAULT_COULOMB_WIDTH)
@@ -196,7 +233,7 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
         el = joints.get(name)
         if el is None:
             continue
-        dyn = el.find('dynamics')
+        dyn = _one(el, 'dynamics', f'joint {name!r}', label)
         if dyn is not None:
             where = f'joint {name!r} <dynamics>'
             for attr, key in (('damping', 'viscous'),
@@ -208,9 +245,14 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
                 if v is not None:
                     vals[key][j] = v
                     found = True
-        ext = el.find(f'{{{DRIVES_NS}}}drive')
+        ext = _one(el, f'{{{DRIVES_NS}}}drive', f'joint {name!r}', label)
         if ext is not None:
             where = f'joint {name!r} <{DRIVES_PREFIX}:drive>'
+            unknown = sorted(set(ext.attrib) - set(DRIVE_ATTRIBUTES))
+            if unknown:
+                raise RobotFileError(
+                    f'{label}: {where}: unknown attribute {unknown[0]!r} '
+                    f'(it takes {", ".join(DRIVE_ATTRIBUTES)})')
             for attr, minimum in (('armature', 0.0), ('offset', None)):
                 v = _number(ext, attr, where, label, minimum=minimum)
                 if v is not None:

@@ -58,7 +58,7 @@ import numpy as np
 
 from .drives import read_drives
 from .errors import RobotFileError, RobotFileWarning
-from .inertia import format_moments, Note, principal_moments
+from .inertia import format_moments, Note, principal_moments, triangle_note
 from .model import pose_matrix, rpy_matrix
 from .text import clip, read_text
 from .urdf_chain import chain_model
@@ -111,6 +111,7 @@ def read_urdf_text(text_or_path, label=None):
     if isinstance(text_or_path, bytes):
         text_or_path = _decode(text_or_path, label or 'robot_description')
     text = str(text_or_path)
+    text = text.removeprefix('\ufeff')     # a byte order mark
     if text.lstrip().startswith('<'):
         label = label or 'robot_description'
         if len(text) > MAX_BYTES:
@@ -118,8 +119,8 @@ def read_urdf_text(text_or_path, label=None):
                 f'{label}: {len(text)} characters, more than the '
                 f'{MAX_BYTES} accepted')
         return text, label
-    return read_text(text, MAX_BYTES, 'URDF file'), label or \
-        os.path.basename(text)
+    body = read_text(text, MAX_BYTES, 'URDF file')
+    return body.removeprefix('\ufeff'), label or os.path.basename(text)
 
 
 def _decode(data, label):
@@ -213,6 +214,7 @@ class _Link:
         self.com = np.zeros(3)
         self.inertia = np.zeros((3, 3))
         self.has_inertial = False
+        self.listed = False     # its inertia is in a prior's note
         self.parent_joint = None
         self.child_joints = []
 
@@ -281,6 +283,14 @@ def _read_inertial(link, el, src):
     if not valid:
         src.accept(f'{where}<inertia>', 'not positive semi-definite '
                    f'(principal moments {format_moments(eig)})')
+        link.listed = True          # a prior's (anything else raised)
+    elif src.prior and triangle_note(where, eig):
+        # the fit replaces it: listed with the prior's others, not
+        # "accepted as published"
+        src.notes.append(f'{where}<inertia>: principal moments '
+                         f'{format_moments(eig)} break the triangle '
+                         f'inequality')
+        link.listed = True
     R = rpy_matrix(*rpy)
     link.mass = mass
     link.com = np.array(xyz)
@@ -458,7 +468,7 @@ def _prior_note(label, notes):
     return [Note(f'{label}: physically impossible values accepted as the '
                  f'prior of an identification (the fit makes every link '
                  f'physical and its friction >= 0; nothing else reads such '
-                 f'a file): ' + _short('; '.join(notes), 600))]
+                 f'a file): ' + _short('; '.join(notes), 1500))]
 
 
 def inspect_urdf(text_or_path, base=None, tip=None, label=None,

@@ -143,8 +143,9 @@ def _tree_warnings(label, links, joints, bodies):
                      f'{_short(", ".join(sorted(set(bodies.massless))), 400)}')
     for parts in bodies.carried:
         for lname, _, _ in parts:
-            # a negative moment is refused, or listed as a prior's
-            if links[lname].has_inertial and links[lname].eig[0] >= 0:
+            # a negative moment is refused; a prior's odd inertia is
+            # listed in its note
+            if links[lname].has_inertial and not links[lname].listed:
                 note = triangle_note(f'{label}: link {lname!r} <inertia>',
                                      links[lname].eig)
                 if note:

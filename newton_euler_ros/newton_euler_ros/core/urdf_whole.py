@@ -138,7 +138,7 @@ def _notes(label, links, joints, walk):
             link = links[lname]
             if not link.has_inertial and joints[via].kind != 'fixed':
                 massless.append(lname)
-            if link.has_inertial:
+            if link.has_inertial and not link.listed:
                 note = triangle_note(f'{label}: link {lname!r} <inertia>',
                                      link.eig)
                 if note:

@@ -76,12 +76,50 @@ def test_read_back_from_urdf():
     ('<dynamics friction="nan"/>', '<dynamics> friction: must be a finite'),
     ('<ne:drive armature="-0.1"/>', '<ne:drive> armature: must be >= 0'),
     ('<ne:drive coulomb_width="0"/>', 'coulomb_width: must be > 0'),
+    # a mistyped attribute is not dropped (armature 0 would be read)
+    ('<ne:drive armatur="0.3"/>',
+     r"joint 'joint3' <ne:drive>: unknown attribute 'armatur' \(it takes "
+     'armature, offset, coulomb_width, torque_constant'),
+    ('<ne:drive armature="0.3"/><ne:drive armature="0.1"/>',
+     r"joint 'joint3': <ne:drive> given 2 times \(once at most\)"),
+    ('<dynamics damping="1"/><dynamics damping="2"/>',
+     r"joint 'joint3': <dynamics> given 2 times"),
 ])
 def test_bad_drive_values_are_one_line(bad, text):
     _, urdf = puma_urdf(bad=bad)
     with pytest.raises(RobotFileError, match=text) as info:
         quiet_urdf(urdf)
     assert '\n' not in str(info.value)
+
+
+@pytest.mark.parametrize('where, path', [
+    ('<ros2_control name="arm" type="system"><joint name="joint2">{}'
+     '</joint></ros2_control>',
+     "<robot name='puma560'> <ros2_control name='arm'> <joint "
+     "name='joint2'>"),
+    ('{}', "<robot name='puma560'>"),
+])
+def test_a_drive_element_where_it_is_not_read_is_refused(where, path):
+    # ignored there, a user's torque constants would silently be lost
+    _, urdf = puma_urdf()
+    placed = where.format('<ne:drive torque_constant="9"/>')
+    urdf = urdf.replace('</robot>', placed + '</robot>')
+    with pytest.raises(RobotFileError) as info:
+        quiet_urdf(urdf)
+    assert str(info.value) == (
+        f'robot_description: <ne:drive> inside {path}: it is read only as a '
+        f"child of the <robot> element's own <joint>")
+
+
+def test_a_byte_order_mark_is_not_part_of_the_urdf(tmp_path):
+    _, urdf = puma_urdf()
+    want = model_drives(quiet_urdf(urdf))
+    path = tmp_path / 'bom.urdf'
+    path.write_text('\ufeff' + urdf, encoding='utf-8')
+    for given in ('\ufeff' + urdf, str(path)):
+        got = model_drives(quiet_urdf(given))
+        np.testing.assert_array_equal(got.viscous, want.viscous)
+        np.testing.assert_array_equal(got.armature, want.armature)
 
 
 def test_drive_torques_and_coulomb_near_rest():

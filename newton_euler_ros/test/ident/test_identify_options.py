@@ -110,6 +110,13 @@ def test_an_impossible_prior_is_accepted_with_one_note(panda, tmp_path):
         text = text[:d] + text[text.index('/>', d) + 2:]
         k = text.index('</joint>', start)
     text = text[:k] + '<dynamics damping="0.1" friction="-0.4"/>' + text[k:]
+    # and moments no real body has (as FloBaRoID's LWR 4+ identification
+    # publishes for every link): in the same note, not one note each
+    for link in ('panda_link2', 'panda_link6'):
+        start = text.index(f'<link name="{link}">')
+        i = text.index('<inertia ', start)
+        text = text[:i] + ('<inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" '
+                           'iyz="0" izz="0.02"') + text[text.index('/>', i):]
     odd = tmp_path / 'odd.urdf'
     odd.write_text(text)
     out = tmp_path / 'out.urdf'
@@ -120,12 +127,17 @@ def test_an_impossible_prior_is_accepted_with_one_note(panda, tmp_path):
              in x]
     assert len(notes) == 1, err
     assert notes[0].startswith('note:')
-    assert 'panda_link5' in notes[0] and 'panda_joint3' in notes[0]
+    for name in ('panda_link5', 'panda_joint3', 'panda_link2', 'panda_link6'):
+        assert name in notes[0], name
+    assert 'triangle' not in err.replace(notes[0], ''), err
     # the identified file is physical, so everything reads it
     model = quiet_load(out)
     pi = inertial_parameters(model).reshape(model.n, 10)
     for k in range(model.n):
         assert np.linalg.eigvalsh(pseudo_inertia(pi[k])).min() > -1e-9
+    code, stdout, err = run('check', out, *CHAIN)
+    assert code == 0, err
+    assert 'triangle' not in stdout and 'semi-definite' not in stdout, stdout
     assert (model_drives(model).coulomb >= 0).all()
     # nothing else accepts the prior itself
     with pytest.raises(RobotFileError, match='not positive semi-definite'):
