@@ -271,10 +271,69 @@ def _print_constants(result, names, tip_frame='the tip frame'):
         print(f'  {name:<24}{K[j]:>10.4g}{tag}')
     if result.payload is not None:
         c = result.payload['com']
-        print(f'known mass {result.payload["mass"]:g} kg: its torque '
-              f'changes by up to {result.mass_excitation.max():.2g} '
-              f'residual RMS; centre of mass found at ({1000 * c[0]:.0f}, '
-              f'{1000 * c[1]:.0f}, {1000 * c[2]:.0f}) mm in {tip_frame}')
+        seen = ('' if result.mass_excitation is None else
+                f'its torque changes by up to '
+                f'{result.mass_excitation.max():.2g} residual RMS; ')
+        print(f'known mass {result.payload["mass"]:g} kg: {seen}centre of '
+              f'mass found at ({1000 * c[0]:.0f}, {1000 * c[1]:.0f}, '
+              f'{1000 * c[2]:.0f}) mm in {tip_frame}')
+
+
+#: relative torque errors this close count as the same (no WORSE warning)
+SAME = 0.01
+
+
+def _compare(nominal, identified, where, worse, level):
+    """File ``where`` under worse (beyond SAME) or level (within it)."""
+    if identified > nominal * (1.0 + SAME):
+        worse.append(where)
+    elif identified >= nominal * (1.0 - SAME):
+        level.append(where)
+
+
+#: a body's mass this many times (or this fraction of) the prior's is noted
+FAR = 3.0
+
+
+def _far_masses(model, result):
+    """
+    Return a note on bodies whose mass moved far from the prior's, or [].
+
+    The recordings see some masses only weakly (where no joint's gravity
+    or motion turns on them alone): the fit keeps every body physical
+    and the torques right, but such a mass may go anywhere that fits.
+    """
+    from .core.regressor import N_INERTIAL
+    from .core.text import clip
+    names = model.info['urdf']['links']
+    m = result.theta[0:N_INERTIAL * model.nb:N_INERTIAL]
+    m0 = result.theta0[0:N_INERTIAL * model.nb:N_INERTIAL]
+    far = [f'{names[k]} {m[k]:.3g} kg (prior {m0[k]:.3g})'
+           for k in range(model.nb)
+           if m0[k] > 0.0 and not 1.0 / FAR <= m[k] / m0[k] <= FAR]
+    if not far:
+        return []
+    return [f'masses more than {FAR:g}x from the prior\'s: '
+            + clip(', '.join(far), 400)
+            + f'; in all {m.sum():.3g} kg (prior {m0.sum():.3g}): the '
+            f'recordings hardly see them; the torques are right, these '
+            f'masses are not (docs/identification.md)']
+
+
+def _listed(items):
+    return (items[0] if len(items) == 1 else
+            f'{", ".join(items[:-1])} and {items[-1]}')
+
+
+def _reads_back(body, args):
+    """Fail, writing nothing, if the URDF to write would be refused."""
+    from .core import NewtonEulerError
+    from .core.urdf import inspect_urdf
+    try:
+        inspect_urdf(body, base=args.base, tip=args.tip, label=args.output)
+    except NewtonEulerError as exc:
+        _fail(f'{args.output}: not written: the identified model would be '
+              f'refused on reading ({exc}); please report this')
 
 
 def cmd_identify(args):
@@ -337,34 +396,36 @@ def cmd_identify(args):
                  f'the RMS effort):', names, {
                      'nominal': result.fit_stats['nominal'],
                      'identified': result.fit_stats['identified']})
-    worse = []
+    worse, level = [], []
     if 'held_out_nominal' in result.fit_stats:
         n0, n1 = _stats_table('on the held-out blocks (not fitted):', names, {
             'nominal': result.fit_stats['held_out_nominal'],
             'identified': result.fit_stats['held_out_identified']})
-        if n1 >= n0:
-            worse.append('the held-out blocks')
+        _compare(n0, n1, 'the held-out blocks', worse, level)
     if result.validate_stats:
         n0, n1 = _stats_table(f'on {args.validate} (validation):', names,
                               result.validate_stats)
-        if n1 >= n0:
-            worse.append(args.validate)
+        _compare(n0, n1, args.validate, worse, level)
     f0 = float(np.nanmean(result.fit_stats['nominal'][1]))
     f1 = float(np.nanmean(result.fit_stats['identified'][1]))
-    if f1 >= f0:
-        worse.append('the recording')
+    _compare(f0, f1, 'the recording', worse, level)
     fixed = fixed_parts(model, text, prior=True)
     body = identified_urdf(text, model, result.theta, fixed, result.drives)
+    _reads_back(body, args)
     try:
         atomic_write(out, body)
     except OSError as exc:
         _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
-    for line in result.notes:
+    for line in result.notes + _far_masses(model, result):
         print(f'note: {line}', file=sys.stderr)
-    for where in worse:
+    if worse:
         print(f'warning: the identified model does WORSE than the nominal on '
-              f'{where}: check the recording (excitation, effort units, '
-              f'joint names)', file=sys.stderr)
+              f'{_listed(worse)}: check the recording (excitation, effort '
+              f'units, joint names)', file=sys.stderr)
+    if level:
+        print(f'note: the identified model is no better than the nominal '
+              f'(within {SAME:.0%}) on {_listed(level)}: the nominal may '
+              f'already be identified from like recordings', file=sys.stderr)
     print(f'wrote {args.output}')
     print(f'identified in {result.seconds:.2f} s'
           + (f', validated in {result.validate_seconds:.2f} s'

@@ -137,6 +137,7 @@ def _setup(args):
     """Model (payload included) and observer; _Usage on bad input."""
     from .core import inspect_robot, NewtonEulerError
     from .core.observer import drive_options, MomentumObserver
+    from .core.robot_file import Note
     from .feedforward_build import payload_model
 
     for name in ('gain', 'max_gap'):
@@ -153,7 +154,8 @@ def _setup(args):
     except NewtonEulerError as exc:
         raise _Usage(str(exc)) from None
     for message in found:
-        print(f'warning: {message}', file=sys.stderr)
+        kind = 'note' if isinstance(message, Note) else 'warning'
+        print(f'{kind}: {message}', file=sys.stderr)
     try:
         model = payload_model(model, args.payload_mass, args.payload_com,
                               [0.0] * 6)

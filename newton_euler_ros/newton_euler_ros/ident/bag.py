@@ -472,8 +472,8 @@ def _check_totals(label, topic, counts, missing_seen, min_samples,
             f'{clip(", ".join(names_seen), 600) or "none"}')
     if counts['kept'] == 0 and counts['no_effort']:
         raise BagError(f'{label}: the JointState messages on {topic!r} '
-                       'have no effort field (efforts are needed to '
-                       'identify)')
+                       'have no effort field (this command needs '
+                       'efforts)')
     if counts['kept'] == 0 and counts['no_position']:
         raise BagError(f'{label}: the JointState messages on {topic!r} '
                        'have no position field')

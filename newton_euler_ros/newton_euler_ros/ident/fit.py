@@ -97,6 +97,10 @@ LAMBDAS = tuple(10.0 ** k for k in range(-8, 1))
 LAMBDA_SLACK = 0.02
 WIDTHS = (0.005, 0.01, 0.02, 0.05, 0.1)
 WIDTH_SLACK = 0.01
+#: an inertial parameter's prior weight (D), at least this x the median one
+PRIOR_FLOOR = 1.0
+#: a body's smallest pseudo-inertia eigenvalue, at least this x its largest
+CONE_MARGIN = 1e-8
 # a recording whose rank is below this fraction of the structural count
 # does not excite the arm
 MIN_RANK_FRACTION = 0.5
@@ -384,6 +388,11 @@ def identify(model, path, topic=DEFAULT_TOPIC, validate=None,
             f'accelerations)')
     D = np.linalg.norm(Aall[:, :layout.p_theta], axis=0)
     D = np.maximum(D, 1e-3 * max(float(np.median(D)), 1e-12))
+    # a parameter the recordings hardly see (a link's mass where its frame
+    # sits on the axes before it) is held to the prior like the others:
+    # with its column's norm alone it drifts to whatever still fits
+    pi = slice(0, N_INERTIAL * nb)
+    D[pi] = np.maximum(D[pi], PRIOR_FLOOR * np.median(D[pi]))
     mass = known[0][1] if known else None
     program = _Program(layout, fixed, theta0, D,
                        _scales(model, theta0, D, layout, mass, Aall), mass)
@@ -520,7 +529,21 @@ def _report(result, recordings, layout, width, x, K, known, program):
 
 
 def _clean(theta, fixed, nb, n):
-    """Project each body's own pseudo-inertia onto the PSD cone."""
+    """
+    Keep each body's own pseudo-inertia J inside the PSD cone.
+
+    The fit leaves weakly excited bodies on the cone's edge (a point
+    mass, a rod, a plate: some eigenvalue of J zero, or a solver's
+    -1e-12), where the rounding of the inertia about the centre of mass
+    tips a principal moment negative or breaks the triangle inequality
+    and the written URDF would be refused on reading.  J's eigenvalues
+    are raised to ``CONE_MARGIN`` times its largest: its inertia about
+    the centre of mass then has principal moments at least twice that
+    and their triangle inequality holds with that margin (the Schur
+    complement of J >= d 1 is >= d 1), far beyond the reader's
+    tolerance (``core.inertia.INERTIA_RTOL``), for a change in the torques
+    of that relative size.
+    """
     from ..core.regressor import pseudo_inertia
     theta = theta.copy()
     for k in range(nb):
@@ -528,8 +551,9 @@ def _clean(theta, fixed, nb, n):
         own = theta[sl] - fixed[k]
         J = pseudo_inertia(own)
         lam, V = np.linalg.eigh(J)
-        if lam.min() < 0:
-            J = (V * np.maximum(lam, 0.0)) @ V.T
+        floor = CONE_MARGIN * lam.max()
+        if lam.max() > 0.0 and lam.min() < floor:
+            J = (V * np.maximum(lam, floor)) @ V.T
             I = np.trace(J[:3, :3]) * np.eye(3) - J[:3, :3]  # noqa: E741
             own = np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], I[0, 0],
                             I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])

@@ -153,6 +153,12 @@ def test_known_mass_gives_the_constants_and_the_targets(current, known_mass,
         assert K[j] == pytest.approx(current['K'][j], rel=0.15), (j, K)
     assert 'torque constants (N m per effort unit), identified' in stdout
     assert 'known mass 2.8 kg' in stdout
+    # masses the recordings hardly see (the upper arm's: its frame is on
+    # the shoulder's axis) stay near the prior, not wherever still fits
+    with open(current['truth'], encoding='utf-8') as f:
+        (tmp_path / 'truth.urdf').write_text(json.load(f)['urdf'])
+    ratio = quiet_load(out).mass / quiet_load(tmp_path / 'truth.urdf').mass
+    assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio
     # replay compares in the current's unit, with the same targets
     code, stdout, err = run('replay', out, current['validation'], *CHAIN,
                             '--csv', tmp_path / 'r.csv')
@@ -264,6 +270,27 @@ def test_constants_given_in_the_urdf_are_used_as_given(current, tmp_path):
     assert code == 2
     one_line_error(err, current['excitation'], 'torque constants', wrong)
     assert not out.exists()
+
+
+def test_identifying_again_from_an_identified_urdf(current, known_mass,
+                                                  tmp_path):
+    # the constants are now given: the known mass is a payload like any
+    # other (it fixes no scale), and the run must not fail on that
+    first, _, _ = known_mass
+    out = tmp_path / 'again.urdf'
+    code, stdout, err = run('identify', first, current['excitation'], *CHAIN,
+                            '-o', out, '--effort', 'current', '--known-mass',
+                            current['known_mass'], 2.8)
+    assert code == 0, err
+    assert 'as given in the nominal URDF' in stdout
+    assert 'known mass 2.8 kg: centre of mass found at' in stdout
+    np.testing.assert_allclose(model_drives(quiet_load(out)).torque_constant,
+                               model_drives(quiet_load(first)).torque_constant,
+                               rtol=1e-12)
+    # about as good as the first: said in one note, not as a warning
+    assert 'WORSE' not in err
+    assert len([x for x in err.splitlines() if 'no better than the nominal '
+                '(within 1%) on' in x]) == 1, err
 
 
 def test_an_effort_of_the_wrong_sign_is_refused(current, tmp_path):
