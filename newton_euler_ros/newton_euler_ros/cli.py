@@ -57,6 +57,7 @@ from .cli_ros import (register as register_ros, RosCliError,  # noqa: E402
 from .core import (coriolis_matrix, gravity_torques,  # noqa: E402
                    inspect_robot, inverse_dynamics, jacobian, mass_matrix,
                    NewtonEulerError, RobotFileError)
+from .core.drives import describe_drives, model_drives  # noqa: E402
 from .core.robot_file import (bundled_robots, Note, read_text,  # noqa: E402
                               to_number)
 
@@ -339,6 +340,8 @@ def cmd_check(args):
               f'{", ".join(report["continuous"]) or "none"}')
     print(f'  total mass: {model.total_mass:.6g} kg')
     print(f'  gravity: {model.gravity.tolist()} m/s^2')
+    for line in describe_drives(model_drives(model), model.joint_names):
+        print(f'  {line}')
     notes = [m for m in found if isinstance(m, Note)]
     print(f'  warnings: {len(found) - len(notes)}')
     for message in found:

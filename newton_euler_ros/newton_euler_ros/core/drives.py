@@ -153,6 +153,23 @@ def _constants(k, n):
     return k
 
 
+def describe_drives(drives, names):
+    """Lines saying the drive terms read, one joint a line (for check)."""
+    if drives is None:
+        return ['drive terms: none (no <dynamics> or <ne:drive>)']
+    k = drives.torque_constant
+    lines = ['drive terms (viscous N m s/rad, Coulomb N m, its width rad/s, '
+             'armature kg m^2, offset N m'
+             + (', torque constant N m per effort unit):' if k is not None
+                else '; no torque constants: efforts are torques):')]
+    for j, name in enumerate(names):
+        lines.append(
+            f'  {name}: {drives.viscous[j]:.6g}, {drives.coulomb[j]:.6g}, '
+            f'{drives.coulomb_width[j]:.6g}, {drives.armature[j]:.6g}, '
+            f'{drives.offset[j]:.6g}' + ('' if k is None else f', {k[j]:.6g}'))
+    return lines
+
+
 def model_drives(model):
     """Return the model's :class:`Drives`, or None when it has none."""
     info = getattr(model, 'info', None) or {}

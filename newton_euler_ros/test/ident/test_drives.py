@@ -111,6 +111,27 @@ def test_a_drive_element_where_it_is_not_read_is_refused(where, path):
         f"child of the <robot> element's own <joint>")
 
 
+def test_check_says_the_drive_terms_it_read(tmp_path):
+    import subprocess
+    import sys
+    _, urdf = puma_urdf()
+    path = tmp_path / 'drives.urdf'
+    path.write_text(urdf)
+    proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
+                           'check', str(path), '--tip', 'tool0'],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    i = next(k for k, x in enumerate(lines) if 'drive terms (' in x)
+    assert 'no torque constants' in lines[i]
+    for j in range(6):
+        name, values = lines[i + 1 + j].strip().split(': ')
+        assert name == f'joint{j + 1}'
+        np.testing.assert_array_equal(
+            [float(v) for v in values.split(', ')],
+            [VIS[j], COUL[j], WIDTH, ARM[j], OFF[j]])
+
+
 def test_a_byte_order_mark_is_not_part_of_the_urdf(tmp_path):
     _, urdf = puma_urdf()
     want = model_drives(quiet_urdf(urdf))

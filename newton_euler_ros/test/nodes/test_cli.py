@@ -94,6 +94,7 @@ def test_check_summarises_or_fails():
     assert code == 0
     assert 'joints: 6 (RRPRRR), standard DH' in out
     assert 'total mass:' in out
+    assert 'drive terms: none' in out
 
 
 @pytest.mark.parametrize('args, message', [
