@@ -39,6 +39,7 @@ written (URDF, CSV, plot) is written atomically.  The identification
 pipeline (``newton_euler_ros.ident``) is imported only by these
 commands, never by the nodes.
 """
+import math
 import os
 import sys
 import textwrap
@@ -145,6 +146,8 @@ def _load_urdf(path, base, tip, prior=False):
     from .core import NewtonEulerError
     from .core.robot_file import Note
     from .core.urdf import inspect_urdf, read_urdf_text
+    if os.path.isdir(path):
+        _fail(f'{path}: is a directory, not a URDF file')
     if not os.path.isfile(path):
         _fail(f'{path}: no such URDF file')
     try:
@@ -325,6 +328,20 @@ def _listed(items):
             f'{", ".join(items[:-1])} and {items[-1]}')
 
 
+def _torque_like(result, args):
+    """A note when identified constants say the efforts are torques."""
+    if result.constants != 'identified':
+        return []
+    seen = [k for j, k in enumerate(result.torque_constant)
+            if j not in result.undetermined_k]
+    mean = float(np.exp(np.mean(np.log(seen)))) if seen else math.nan
+    if not 0.8 <= mean <= 1.25:
+        return []
+    return [f'the torque constants are {mean:.2f} N m per effort unit on '
+            f'average: the efforts may be torques already (then identify '
+            f'without --effort {args.effort})']
+
+
 def _reads_back(body, args):
     """Fail, writing nothing, if the URDF to write would be refused."""
     from .core import NewtonEulerError
@@ -416,7 +433,8 @@ def cmd_identify(args):
         atomic_write(out, body)
     except OSError as exc:
         _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
-    for line in result.notes + _far_masses(model, result):
+    for line in (result.notes + _far_masses(model, result)
+                 + _torque_like(result, args)):
         print(f'note: {line}', file=sys.stderr)
     if worse:
         print(f'warning: the identified model does WORSE than the nominal on '

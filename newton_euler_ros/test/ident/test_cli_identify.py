@@ -206,13 +206,17 @@ def bad_case(case, tmp_path, example, panda):
         urdf = tmp_path / 'nope.urdf'
         small_bag(bag, panda)
         return [urdf, bag] + topic, [urdf]
+    elif case == 'swapped':         # the bag (a folder) given as the URDF
+        small_bag(bag, panda)
+        return [bag, bag] + topic, [bag]
     return [urdf, bag] + topic, [bag]
 
 
 BAD = [('missing', 'no such bag'), ('corrupt', 'cannot open'),
        ('topic', "no topic '/arm/joint_states'"), ('effort', 'no effort'),
        ('joint', 'panda_joint7'), ('short', 'too short'),
-       ('still', 'does not excite'), ('urdf', 'no such URDF')]
+       ('still', 'does not excite'), ('urdf', 'no such URDF'),
+       ('swapped', 'is a directory, not a URDF file')]
 
 
 @pytest.mark.parametrize('case, words', BAD)

@@ -146,7 +146,8 @@ def test_torque_bag_passes_and_meets_the_held_out_targets(torque, tmp_path):
 
 def test_known_mass_gives_the_constants_and_the_targets(current, known_mass,
                                                         tmp_path):
-    out, stdout, _ = known_mass
+    out, stdout, err = known_mass
+    assert 'torques already' not in err, err
     K = model_drives(quiet_load(out)).torque_constant
     assert K is not None
     for j in GRAVITY_LOADED:

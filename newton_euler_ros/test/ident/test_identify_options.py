@@ -226,3 +226,16 @@ def test_the_solver_reaches_full_accuracy(ur_torque, monkeypatch):
     assert len(result.notes) == 1
     assert 'reduced accuracy' in result.notes[0]
     assert '\n' not in result.notes[0]
+
+
+def test_currents_that_are_torques_are_said_to_be(panda, tmp_path):
+    # a Franka user's torque recording, given --effort current by mistake:
+    # constants near 1 N m per unit, and a note that says what that means
+    out = tmp_path / 'out.urdf'
+    code, stdout, err = run('identify', panda['urdf'], panda['recording'],
+                            *CHAIN, '-o', out, '--effort', 'current')
+    assert code == 0, err
+    notes = [x for x in err.splitlines() if 'may be torques already' in x]
+    assert len(notes) == 1, err
+    assert notes[0].endswith('(then identify without --effort current)')
+    # (a UR's currents get no such note: test_current_arm.py)
