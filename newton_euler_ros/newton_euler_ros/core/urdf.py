@@ -67,7 +67,9 @@ from .urdf_whole import tree_model
 from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
 
 MAX_BYTES = 16 * 1024 * 1024
-MAX_ELEMENTS = 20000
+#: links plus joints: robots have hundreds (a dual-arm TIAGo 350); a
+#: chain of thousands would cost check's O(n^3) singularity test minutes
+MAX_ELEMENTS = 4000
 MAX_NAME = 200
 JOINT_TYPES = ('revolute', 'continuous', 'prismatic', 'fixed', 'floating',
                'planar')

@@ -569,6 +569,11 @@ def test_file_errors_name_the_file(tmp_path):
             load_robot(str(path))
     with pytest.raises(RobotFileError, match=r'characters, more than the'):
         load_urdf('<robot>' + ' ' * (16 * 1024 * 1024) + '</robot>')
+    # a small file can still describe an absurd robot: bounded too
+    many = ''.join(f'<link name="l{i}"/>' for i in range(4001))
+    with pytest.raises(RobotFileError, match=r'^robot_description: 4001 '
+                       r'links and 0 joints, more than the 4000 accepted$'):
+        load_urdf(f'<robot name="r">{many}</robot>')
 
 
 def test_base_and_tip_apply_to_urdf_only():
