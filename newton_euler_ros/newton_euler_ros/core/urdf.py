@@ -140,7 +140,12 @@ def _parse(text, src):
         root = DET.fromstring(text, forbid_dtd=True, forbid_entities=True,
                               forbid_external=True)
     except defusedxml.DefusedXmlException as exc:
-        raise RobotFileError(f'{src.label}: refused: {exc} (DTDs and '
+        what = {'DTDForbidden': 'a <!DOCTYPE> declaration',
+                'EntitiesForbidden': f'an entity declaration '
+                                     f'({getattr(exc, "name", "")!r})',
+                'ExternalReferenceForbidden': 'an external reference'}.get(
+                    type(exc).__name__, type(exc).__name__)
+        raise RobotFileError(f'{src.label}: refused: {what} (DTDs and '
                              f'entities are not accepted in URDF)') from None
     except ET.ParseError as exc:
         line, col = getattr(exc, 'position', (0, 0))
