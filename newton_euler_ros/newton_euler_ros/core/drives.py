@@ -210,6 +210,12 @@ def _one(el, tag, where, label):
 def _placed(root, label):
     """Refuse a <ne:drive> that is not a robot-level joint's child."""
     tag = f'{{{DRIVES_NS}}}drive'
+    for el in root.iter():
+        ns = el.tag[1:].split('}')[0] if str(el.tag).startswith('{') else ''
+        if ns != DRIVES_NS and ns.startswith(DRIVES_NS.rsplit('/', 1)[0]):
+            raise RobotFileError(
+                f'{label}: <{el.tag.split("}")[1]}> of namespace {ns!r}: '
+                f'not one this version reads ({DRIVES_NS})')
     own = sum(len(j.findall(tag)) for j in root.findall('joint'))
     if own == sum(1 for _ in root.iter(tag)):
         return

@@ -111,6 +111,16 @@ def test_a_drive_element_where_it_is_not_read_is_refused(where, path):
         f"child of the <robot> element's own <joint>")
 
 
+def test_a_drive_namespace_of_another_version_is_refused():
+    _, urdf = puma_urdf()
+    other = DRIVES_NS[:-1] + '2'
+    with pytest.raises(RobotFileError) as info:
+        quiet_urdf(urdf.replace(DRIVES_NS, other))
+    assert str(info.value) == (
+        f"robot_description: <drive> of namespace '{other}': not one this "
+        f'version reads ({DRIVES_NS})')
+
+
 def test_check_says_the_drive_terms_it_read(tmp_path):
     import subprocess
     import sys
