@@ -54,7 +54,10 @@ def model_line(ff, source, mode, payload, params):
         f'{effects}, payload {payload[0]} kg, wrench frames '
         f'{clip(str(sorted(ff.wrench.frames)), 400)}'
         + ('' if not params['drives.compensate'] else
-           ', drive terms compensated' if ff.drives is not None else
+           ', drive terms compensated (largest Coulomb friction '
+           f'{ff.drives.coulomb.max():.3g}, rotor inertia '
+           f'{ff.drives.armature.max():.3g}; newton-euler check lists '
+           'them)' if ff.drives is not None else
            ', drives.compensate is on but the robot has no drive '
            'terms')
         + (', without g(q): the robot adds it '

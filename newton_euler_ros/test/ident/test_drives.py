@@ -231,7 +231,9 @@ def test_node_compensates_only_when_asked(tmp_path):
             np.testing.assert_allclose(
                 on.effort, rigid + drives.torques(qd, np.zeros(model.n)),
                 rtol=1e-12, atol=1e-12)
-        assert 'drive terms compensated' in nodes['on'].log()
+        assert (f'drive terms compensated (largest Coulomb friction '
+                f'{max(COUL):.3g}, rotor inertia {max(ARM):.3g}; '
+                f'newton-euler check lists them)') in nodes['on'].log()
     finally:
         for node in nodes.values():
             node.stop()
