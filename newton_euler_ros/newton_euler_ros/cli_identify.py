@@ -39,7 +39,6 @@ written (URDF, CSV, plot) is written atomically.  The identification
 pipeline (``newton_euler_ros.ident``) is imported only by these
 commands, never by the nodes.
 """
-import math
 import os
 import sys
 import textwrap
@@ -294,52 +293,9 @@ def _compare(nominal, identified, where, worse, level):
         level.append(where)
 
 
-#: a body's mass this many times (or this fraction of) the prior's is noted
-FAR = 3.0
-
-
-def _far_masses(model, result):
-    """
-    Return a note on bodies whose mass moved far from the prior's, or [].
-
-    The recordings see some masses only weakly (where no joint's gravity
-    or motion turns on them alone): the fit keeps every body physical
-    and the torques right, but such a mass may go anywhere that fits.
-    """
-    from .core.regressor import N_INERTIAL
-    from .core.text import clip
-    names = model.info['urdf']['links']
-    m = result.theta[0:N_INERTIAL * model.nb:N_INERTIAL]
-    m0 = result.theta0[0:N_INERTIAL * model.nb:N_INERTIAL]
-    far = [f'{names[k]} {m[k]:.3g} kg (prior {m0[k]:.3g})'
-           for k in range(model.nb)
-           if m0[k] > 0.0 and not 1.0 / FAR <= m[k] / m0[k] <= FAR]
-    if not far:
-        return []
-    return [f'masses more than {FAR:g}x from the prior\'s: '
-            + clip(', '.join(far), 400)
-            + f'; in all {m.sum():.3g} kg (prior {m0.sum():.3g}): the '
-            f'recordings hardly see them; the torques are right, these '
-            f'masses are not (docs/identification.md)']
-
-
 def _listed(items):
     return (items[0] if len(items) == 1 else
             f'{", ".join(items[:-1])} and {items[-1]}')
-
-
-def _torque_like(result, args):
-    """A note when identified constants say the efforts are torques."""
-    if result.constants != 'identified':
-        return []
-    seen = [k for j, k in enumerate(result.torque_constant)
-            if j not in result.undetermined_k]
-    mean = float(np.exp(np.mean(np.log(seen)))) if seen else math.nan
-    if not 0.8 <= mean <= 1.25:
-        return []
-    return [f'the torque constants are {mean:.2f} N m per effort unit on '
-            f'average: the efforts may be torques already (then identify '
-            f'without --effort {args.effort})']
 
 
 def _reads_back(body, args):
@@ -376,6 +332,7 @@ def cmd_identify(args):
                       '--known-mass-link')
     from .ident.fit import fixed_parts
     from .ident.problem import REST_FRACTION, REST_SPEED, rest_speeds
+    from .ident.notes import far_masses, torque_like
     from .ident.urdf_out import atomic_write, identified_urdf
     result = _identify_or_fail(model, text, args)
     names = model.joint_names
@@ -433,8 +390,8 @@ def cmd_identify(args):
         atomic_write(out, body)
     except OSError as exc:
         _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
-    for line in (result.notes + _far_masses(model, result)
-                 + _torque_like(result, args)):
+    for line in (result.notes + far_masses(model, result)
+                 + torque_like(result)):
         print(f'note: {line}', file=sys.stderr)
     if worse:
         print(f'warning: the identified model does WORSE than the nominal on '

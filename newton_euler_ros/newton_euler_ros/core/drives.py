@@ -154,7 +154,7 @@ def _constants(k, n):
 
 
 def describe_drives(drives, names):
-    """Lines saying the drive terms read, one joint a line (for check)."""
+    """Return lines saying the drive terms read, a joint a line (check)."""
     if drives is None:
         return ['drive terms: none (no <dynamics> or <ne:drive>)']
     k = drives.torque_constant
@@ -198,7 +198,7 @@ DRIVE_ATTRIBUTES = ('armature', 'offset', 'coulomb_width', 'torque_constant')
 
 
 def _one(el, tag, where, label):
-    """The joint's element ``tag``, or None; given twice is an error."""
+    """Return the joint's element ``tag`` or None; refuse it twice."""
     found = el.findall(tag)
     if len(found) > 1:
         shown = tag.replace(f'{{{DRIVES_NS}}}', f'{DRIVES_PREFIX}:')
@@ -232,7 +232,7 @@ def _placed(root, label):
         raise RobotFileError(
             f'{label}: <{DRIVES_PREFIX}:drive> inside '
             f'{" ".join(reversed(path))}: it is read only as a child of '
-            f'the <robot> element\'s own <joint>')
+            f"the <robot> element's own <joint>")
 
 
 def read_drives(root, joint_names, label='robot_description', prior=False,

@@ -151,22 +151,22 @@ def test_impossible_nominal_inertials_are_a_prior_with_a_note(example,
 
 def test_masses_far_from_the_prior_are_said_in_one_note(example):
     from types import SimpleNamespace
-    from newton_euler_ros.cli_identify import _far_masses
+    from newton_euler_ros.ident.notes import far_masses
     from newton_euler_ros.core.urdf import inspect_urdf
     from newton_euler_ros.ident.fit import nominal_theta
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
         model, _, _ = inspect_urdf(example['urdf'], base=BASE, tip=TIP)
     theta0 = nominal_theta(model)
-    assert _far_masses(model, SimpleNamespace(theta=theta0,
-                                              theta0=theta0)) == []
+    same = SimpleNamespace(theta=theta0, theta0=theta0)
+    assert far_masses(model, same) == []
     theta = theta0.copy()
     theta[10 * 1] *= 4.0            # the second body's mass alone
     theta[10 * 5] /= 2.5            # within the factor: not named
-    notes = _far_masses(model, SimpleNamespace(theta=theta, theta0=theta0))
+    notes = far_masses(model, SimpleNamespace(theta=theta, theta0=theta0))
     assert len(notes) == 1 and '\n' not in notes[0]
     name = model.info['urdf']['links'][1]
-    assert notes[0].startswith(f'masses more than 3x from the prior\'s: '
+    assert notes[0].startswith(f"masses more than 3x from the prior's: "
                                f'{name} '), notes[0]
     assert model.info['urdf']['links'][5] not in notes[0]
 

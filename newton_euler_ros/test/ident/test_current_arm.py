@@ -274,7 +274,7 @@ def test_constants_given_in_the_urdf_are_used_as_given(current, tmp_path):
 
 
 def test_identifying_again_from_an_identified_urdf(current, known_mass,
-                                                  tmp_path):
+                                                   tmp_path):
     # the constants are now given: the known mass is a payload like any
     # other (it fixes no scale), and the run must not fail on that
     first, _, _ = known_mass

@@ -35,7 +35,7 @@ from scipy.spatial.transform import Rotation
 
 
 def _edge_body(rng, kind):
-    """A body whose pseudo-inertia has one zero eigenvalue (or more)."""
+    """Return a body whose pseudo-inertia has a zero eigenvalue (or more)."""
     m = rng.uniform(0.5, 5.0)
     c = rng.uniform(-0.4, 0.4, 3)
     s = {'point': [0.0, 0.0, 0.0], 'rod': [0.0, 0.0, 1.0],

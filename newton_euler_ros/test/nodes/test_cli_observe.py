@@ -161,7 +161,8 @@ def test_bad_inputs_are_one_line_and_exit_2(files, case):
         args += list(expect[:-1])
     code, out, err = run(*args)
     assert code == 2, (out, err)
-    lines = [x for x in err.splitlines() if not x.startswith('warning:')]
+    lines = [x for x in err.splitlines()
+             if not x.startswith(('warning:', 'note:'))]
     assert len(lines) == 1 and lines[0].startswith('newton-euler: error:')
     assert expect[-1] in lines[0], lines[0]
     assert 'Traceback' not in err
