@@ -36,7 +36,7 @@ from .core.drives import model_drives
 from .core.effects import EffectDynamics, RIGID_BODY
 from .core.trajectory import trajectory_efforts
 from .joint_inputs import InputRejected
-from .safety import TorqueGuard, velocity_bounds
+from .safety import joint_units, TorqueGuard, velocity_bounds
 from .wrenches import WrenchInput
 
 MODES = ('gravity', 'gravity_coriolis', 'full')
@@ -115,7 +115,10 @@ class FeedforwardComputer:
         """
         ff = cls(model, order, wrench_input, reference, scene, mode,
                  guard=TorqueGuard(order.to_output_order(bounds),
-                                   params['limits.action']),
+                                   params['limits.action'],
+                                   order.output_joints,
+                                   order.to_output_order(np.array(
+                                       joint_units(model), dtype=object))),
                  bound_sources=[bound_sources[k] for k in order.to_output],
                  velocity_bounds=velocity_bounds(
                      model, params['limits.velocity_factor'],
@@ -271,7 +274,8 @@ class FeedforwardComputer:
         On a whole robot the joints it leaves out are held at the last
         joint state, at rest.  Return (efforts, a row per point in the
         order of ``names``, or None when the guard drops them; whether a
-        point exceeded the torque bounds).
+        point exceeded the torque bounds: ``{joint: (largest torque asked,
+        bound, unit)}`` of the joints over, empty within them).
         """
         w, frame = (self.wrench.current(now) if include_wrench
                     else (None, 'base'))
@@ -284,19 +288,21 @@ class FeedforwardComputer:
         except NewtonEulerError as exc:
             raise InputRejected('malformed', str(exc)) from None
         if self.guard is None:
-            return efforts, False
+            return efforts, {}
         out = efforts.copy()
-        exceeded = False
         # the bounds of the trajectory's joints, in its order
-        where = {name: k for k, name in enumerate(self.output_names)}
-        guard = TorqueGuard(self.guard.bounds[[where[name] for name in
-                                               names]],
-                            self.guard.action)
+        guard = self.guard.sub(names)
+        # the joints over, each with the largest torque asked at a point
+        peak = (efforts[np.abs(efforts).argmax(axis=0),
+                        np.arange(len(names))]
+                if efforts.shape[0] else np.zeros(len(names)))
+        exceeded = guard.over(peak)
+        if not exceeded:
+            return out, exceeded
         for k in range(out.shape[0]):
-            row, over = guard.check(efforts[k])
-            exceeded |= over
+            row, _ = guard.check(efforts[k])
             if row is None:
-                return None, True
+                return None, exceeded
             out[k] = row
         return out, exceeded
 

@@ -47,6 +47,10 @@ import numpy as np
 from .core import gravity_torques, jacobian, mass_matrix
 
 ACTIONS = ('clamp', 'drop', 'publish')
+#: where a bound comes from (:func:`effort_bounds`), in words
+BOUND_SOURCES = {'parameter': 'limits.effort',
+                 'robot': "the robot's effort limits",
+                 'derived': 'derived from the robot (it states none)'}
 ACCELERATION = 20.0         # rad/s^2 (or m/s^2) for the derived bound
 SAMPLES = 64
 
@@ -136,15 +140,21 @@ class TorqueGuard:
     Apply the torque bounds to outgoing torques (output order).
 
     :meth:`check` returns the torques to publish (clamped if so chosen)
-    or None to drop the message, and whether a bound was exceeded.
+    or None to drop the message, and whether a bound was exceeded;
+    :meth:`over` names the joints above their bound.  ``names`` and
+    ``units`` ('N m' or 'N') are the joints' (default: their indices).
     """
 
-    def __init__(self, bounds, action='clamp'):
+    def __init__(self, bounds, action='clamp', names=None, units=None):
         if action not in ACTIONS:
             raise ValueError(f'limits.action: must be one of '
                              f'{", ".join(ACTIONS)}, got {action!r}')
         self.bounds = np.asarray(bounds, dtype=np.float64)
         self.action = action
+        n = self.bounds.size
+        self.names = (list(names) if names is not None
+                      else [f'joint {j}' for j in range(n)])
+        self.units = list(units) if units is not None else ['N m/N'] * n
 
     def check(self, tau):
         """Return (torques or None, exceeded)."""
@@ -156,3 +166,53 @@ class TorqueGuard:
         if self.action == 'clamp':
             return np.clip(tau, -self.bounds, self.bounds), True
         return tau, True
+
+    def over(self, tau):
+        """
+        Return {joint: (torque asked, bound, unit)} above their bound.
+
+        Only the joints over, in output order; empty within the bounds.
+        """
+        tau = np.asarray(tau, dtype=np.float64)
+        return {self.names[j]: (float(tau[j]), float(self.bounds[j]),
+                                self.units[j])
+                for j in np.flatnonzero(np.abs(tau) > self.bounds)}
+
+    def sub(self, names):
+        """Return the guard of some joints (by name), in that order."""
+        at = [self.names.index(name) for name in names]
+        return TorqueGuard(self.bounds[at], self.action, names,
+                           [self.units[k] for k in at])
+
+
+def joint_units(model):
+    """Return 'N m' or 'N' per coordinate (revolute or prismatic)."""
+    return ['N' if model.joint_types[b] == 'prismatic' else 'N m'
+            for b in model.independent]
+
+
+def over_text(over):
+    """Say the joints over their bound: 'j2 asked 31.2 N m, bound 12'."""
+    return '; '.join(f'{name} asked {asked:.4g} {unit}, bound {bound:.4g}'
+                     for name, (asked, bound, unit) in over.items())
+
+
+class OverLimitLog:
+    """
+    Say the joints over their torque bound once per change of their set.
+
+    :meth:`news` is True when ``over`` names another set of joints than
+    the last one said (not when back within the bounds: a torque
+    hovering at its bound is not said at every crossing).
+    """
+
+    def __init__(self):
+        self.said = None
+
+    def news(self, over):
+        """Return whether ``over``'s joints should be said now."""
+        joints = frozenset(over)
+        if not joints or joints == self.said:
+            return False
+        self.said = joints
+        return True

@@ -41,6 +41,7 @@ Publishes
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
 """
+import collections
 import sys
 import threading
 import time
@@ -68,6 +69,7 @@ from ..feedforward_build import (build_computer, check_payload,
                                  is_whole_robot, PAYLOAD)
 from ..joint_inputs import InputRejected
 from ..parameters import load_specs
+from ..safety import BOUND_SOURCES, over_text, OverLimitLog
 from ..sim.scene import load_scene
 from ..wrenches import wrench_input
 
@@ -94,6 +96,8 @@ class InverseDynamicsNode(SharedGraphNode):
         self.counts = dict.fromkeys(COUNTERS, 0)
         self.log_throttle = p['log_throttle']
         self._last_log = {}
+        # the joints over their torque bound, said once per change
+        self._over_log = collections.defaultdict(OverLimitLog)
         self.ff = None          # swapped whole when a new model arrives
         self.model_source = ''
         #: why the last robot_description was rejected ('' when it loaded)
@@ -348,9 +352,10 @@ class InverseDynamicsNode(SharedGraphNode):
         except Exception as exc:  # never let a message kill the node
             self._reject('joint state', exc)
             return
+        asked = tau
         tau, exceeded = ff.guard.check(tau)
         if exceeded:
-            self._over_limit(ff, 'torque command')
+            self._over_limit(ff, 'torque command', ff.guard.over(asked))
             if tau is None:
                 return
         values = tau.tolist()
@@ -365,19 +370,20 @@ class InverseDynamicsNode(SharedGraphNode):
         if self._observer is not None:
             self._observer.observe(ff, msg, self._reject)
 
-    def _over_limit(self, ff, what):
+    def _over_limit(self, ff, what, over):
+        """Count a torque over its bound; say which once per change."""
         self.counts['over_limit'] += 1
+        if not self._over_log[what].news(over):
+            return
         action = {'clamp': 'clamped to it', 'drop': 'not published',
                   'publish': 'published anyway'}[ff.guard.action]
-        now = time.monotonic()
-        if now - self._last_log.get('over_limit', -1e300) >= \
-                self.log_throttle:
-            self._last_log['over_limit'] = now
-            self.get_logger().warning(
-                f'{what} above the torque bound ({action}): bounds '
-                f'{ff.guard.bounds.tolist()} N m/N from '
-                f'{sorted(set(ff.bound_sources))} '
-                f'({self.counts["over_limit"]} so far)')
+        sources = sorted({ff.bound_sources[ff.output_names.index(name)]
+                          for name in over})
+        self.get_logger().warning(
+            f'{what} above the torque bound ({action}): {over_text(over)} '
+            f'(bounds from {", ".join(BOUND_SOURCES[s] for s in sources)}; '
+            f'{self.counts["over_limit"]} over so far; said again when '
+            f'other joints go over)')
 
     def _on_wrench(self, msg):
         w = msg.wrench
@@ -429,7 +435,7 @@ class InverseDynamicsNode(SharedGraphNode):
             self._reject('trajectory', exc)
             return
         if exceeded:
-            self._over_limit(ff, 'trajectory effort')
+            self._over_limit(ff, 'trajectory effort', exceeded)
         if efforts is None:
             return
         for pt, effort in zip(msg.points, efforts):

@@ -76,7 +76,8 @@ from ..core import NewtonEulerError
 from ..core.trajectory import TrajectoryFollower
 from ..feedforward_build import PAYLOAD, payload_model
 from ..parameters import load_specs
-from ..safety import effort_bounds, TorqueGuard
+from ..safety import (effort_bounds, joint_units, over_text,
+                      OverLimitLog, TorqueGuard)
 from ..sim.scene import load_scene
 from ..sim.simulate import integrator_step, SceneDynamics
 
@@ -133,7 +134,9 @@ class RobotSimNode(SharedGraphNode):
         # the same torque guard as inverse_dynamics_node: the robot's
         # effort limits, else bounds derived from it
         self.guard = TorqueGuard(effort_bounds(scene.model)[0],
-                                 p['limits.action'])
+                                 p['limits.action'], scene.model.joint_names,
+                                 joint_units(scene.model))
+        self.over_log = OverLimitLog()   # said once per change of joints
         n = scene.model.n
         self.q = scene.q0.astype(float).copy()
         self.qd = scene.qd0.astype(float).copy()
@@ -312,10 +315,12 @@ class RobotSimNode(SharedGraphNode):
         out, exceeded = self.guard.check(tau)
         if exceeded:
             self.over_limit += 1
-            self.get_logger().warning(
-                f'command above the torque bounds {self.guard.bounds.tolist()}'
-                f' ({self.guard.action}; {self.over_limit} so far)',
-                throttle_duration_sec=2.0)
+            over = self.guard.over(tau)
+            if self.over_log.news(over):
+                self.get_logger().warning(
+                    f'command above the torque bound ({self.guard.action}): '
+                    f'{over_text(over)} ({self.over_limit} over so far; '
+                    f'said again when other joints go over)')
         return out
 
     def _plant(self, payload):

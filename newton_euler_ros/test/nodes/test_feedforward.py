@@ -244,7 +244,9 @@ def test_a_trajectorys_efforts_are_guarded_by_its_joints_bounds(puma):
         ff = FeedforwardComputer.from_parameters(
             params, puma, order, WrenchInput([], []), low, sources)
         efforts, exceeded = ff.trajectory(names, points, 0.0)
-        assert exceeded
+        # the one joint over, with the largest torque asked and its bound
+        k = int(np.abs(expected[:, j]).argmax())
+        assert exceeded == {names[j]: (expected[k, j], low[at[j]], 'N m')}
         if action == 'drop':
             assert efforts is None
             continue
@@ -262,3 +264,27 @@ def test_a_trajectorys_efforts_are_guarded_by_its_joints_bounds(puma):
         ff.trajectory(names, [{'time_from_start': 0.0,
                                'positions': [0.0]}], 0.0)
     assert info.value.kind == 'malformed'
+
+
+def test_the_torque_bound_warning_names_the_joints_once_per_change(puma):
+    """
+    Only the joints over, with the torque asked and the bound.
+
+    Said again only when another set of joints goes over, not at every
+    message.
+    """
+    from newton_euler_ros.safety import (joint_units, over_text,
+                                         OverLimitLog, TorqueGuard)
+    guard = TorqueGuard([10.0, 20.0, 5.0], 'clamp', ['a', 'b', 'c'],
+                        ['N m', 'N m', 'N'])
+    over = guard.over([12.0, -1.0, -7.5])
+    assert over == {'a': (12.0, 10.0, 'N m'), 'c': (-7.5, 5.0, 'N')}
+    assert over_text(over) == ('a asked 12 N m, bound 10; '
+                               'c asked -7.5 N, bound 5')
+    assert guard.over([1.0, 1.0, 1.0]) == {}
+    log = OverLimitLog()
+    said = [log.news(guard.over(tau)) for tau in (
+        [12.0, 0, 0], [13.0, 0, 0], [0, 0, 0], [12.5, 0, 0],
+        [12.0, 0, 9.0], [12.0, 0, 9.0], [0, 30.0, 0])]
+    assert said == [True, False, False, False, True, False, True]
+    assert joint_units(puma) == ['N m'] * 6

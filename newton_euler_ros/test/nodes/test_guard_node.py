@@ -181,7 +181,20 @@ def test_torques_above_the_limits_are_clamped(clamp, panda):
     assert np.all(np.abs(tau) <= LIMITS)
     assert np.all(np.abs(clamp.cmds[-1].data) <= LIMITS)
     assert clamp.counted('over_limit', before)
-    assert 'above the torque bound (clamped to it)' in clamp.node.log()
+    # more states over the same joints: counted, not said again
+    for _ in range(3):
+        clamp.send(panda.joint_names, Q, np.zeros(7), wait=1.0)
+    # said once, naming only the joints over, the torques asked and the
+    # bounds (not the seven bounds of every joint)
+    said = [line for line in clamp.node.log().splitlines()
+            if 'above the torque bound' in line]
+    assert len(said) == 1, said
+    over = [f'{panda.joint_names[j]} asked {raw[j]:.4g} N m, bound '
+            f'{LIMITS[j]:.4g}' for j in np.flatnonzero(np.abs(raw) > LIMITS)]
+    assert ('torque command above the torque bound (clamped to it): '
+            + '; '.join(over) + " (bounds from the robot's effort limits; "
+            in said[0]), said
+    assert '[87.0, 87.0' not in said[0]
     clamp.wrench('tool0', np.zeros(6))
     free = inverse_dynamics(panda, Q)
     clamp.send_until(panda.joint_names, Q, np.zeros(7),
