@@ -382,6 +382,8 @@ def cmd_simulate(args):
     from .sim.scene import load_scene
     from .sim.simulate import simulate
     scene = load_scene(args.scene)
+    if args.engine is not None and args.engine != scene.engine:
+        scene = _with_engine(scene, args.engine)
     _warn(scene.warnings)
     if args.duration is not None and not args.duration > 0.0:
         raise CliError(f'--duration must be > 0, got {args.duration}')
@@ -402,14 +404,31 @@ def cmd_simulate(args):
         'PD + feedforward' if scene.feedforward else 'PD alone')
     print(f'tracking error ({ff}): RMS {summary["tracking_rms"]:.3e} rad, '
           f'max {summary["tracking_max"]:.3e} rad')
-    print(f'energy drift: {summary["energy_drift_max"]:.3e} J '
-          f'({summary["energy_drift_relative"]:.1e} of the energy scale)')
+    if summary['energy_drift_max'] is None:
+        print('energy drift: not booked (MuJoCo with friction, a wrench '
+              'or contacts)')
+    else:
+        print(f'energy drift: {summary["energy_drift_max"]:.3e} J '
+              f'({summary["energy_drift_relative"]:.1e} of the energy '
+              f'scale)')
     print('final state:')
     w = max(12, *(len(x) for x in names))       # names are never cut
     for j, name in enumerate(names):
         print(f'  {name:<{w}} q {summary["final_q"][j]:>12.6f}   '
               f'qd {summary["final_qd"][j]:>12.6f}')
     return 0
+
+
+def _with_engine(scene, engine):
+    """Return the scene on another engine (contacts need MuJoCo)."""
+    import dataclasses
+    if engine != 'mujoco' and scene.contacts is not None:
+        raise CliError(f'--engine {engine}: {scene.path} has contacts, '
+                       f'which only the MuJoCo engine simulates')
+    if engine == 'mujoco' and not scene.effects.velocity_products:
+        raise CliError(f'--engine mujoco: {scene.path} leaves velocity '
+                       f'products out, and MuJoCo always has them')
+    return dataclasses.replace(scene, engine=engine)
 
 
 def cmd_feedforward(args):
@@ -536,6 +555,9 @@ def build_parser():
     sim.add_argument('--no-feedforward', action='store_true',
                      help='PD alone, without the inverse-dynamics '
                           'feedforward (for comparison)')
+    sim.add_argument('--engine', choices=('newton_euler', 'mujoco'),
+                     help="the plant: this library's dynamics or MuJoCo's "
+                          "full physics (default: the scene's engine:)")
     sim.set_defaults(func=cmd_simulate)
     ff = sub.add_parser('feedforward', help='fill the effort of every point '
                                             'of a joint trajectory')

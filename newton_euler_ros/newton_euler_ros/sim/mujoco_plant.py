@@ -47,8 +47,10 @@ class MujocoPlant:
         robot.set_state(self.data, q0)
         self.held = True        # brakes on until release()
         self._hold_q = self.data.qpos.copy()
-        self._wrench = np.zeros(6)
         self._force = np.zeros(6)
+        # callables hook(plant) run before every physics step (scene
+        # objects that follow the robot or apply loads)
+        self.hooks = []
 
     @property
     def time(self):
@@ -75,8 +77,10 @@ class MujocoPlant:
             d.time += steps * m.opt.timestep
             return
         d.ctrl[self.robot.actuator] = tau
-        step = self.mujoco.mj_step
+        step, hooks = self.mujoco.mj_step, self.hooks
         for _ in range(steps):
+            for hook in hooks:
+                hook(self)
             step(m, d)
 
     def hold(self):
@@ -118,17 +122,16 @@ class MujocoPlant:
     def _robot_bodies(self):
         cached = getattr(self, '_bodies', None)
         if cached is None:
-            m = self.model
+            m, mujoco = self.model, self.mujoco
             mark = np.zeros(m.nbody, dtype=bool)
-            for j in range(m.njnt):
+            names = list(self.robot.joints) + [
+                f[0] for f in self.robot.followers]
+            for name in names:
+                j = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, name)
                 mark[m.jnt_bodyid[j]] = True
             # a body welded below a moving one is part of the robot too;
             # bodies are stored parents first
             for b in range(1, m.nbody):
                 mark[b] |= mark[m.body_parentid[b]]
-            names = set(getattr(self, 'scene_bodies', ()))
-            for b in range(m.nbody):
-                if m.body(b).name in names:
-                    mark[b] = False
             cached = self._bodies = mark
         return cached

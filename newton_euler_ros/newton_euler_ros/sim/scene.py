@@ -35,7 +35,9 @@ from ..core.robot_file import (_check_keys, _short, inspect_robot, read_yaml,
                                to_number, to_vector)
 
 SCENE_KEYS = {'name', 'description', 'robot', 'effects', 'initial',
-              'reference', 'controller', 'integrator'}
+              'reference', 'controller', 'integrator', 'engine',
+              'contacts'}
+ENGINES = ('newton_euler', 'mujoco')
 EFFECT_KEYS = {'gravity', 'velocity_products', 'payload', 'wrench',
                'friction', 'armature'}
 INTEGRATORS = ('rk4', 'semi_implicit_euler')
@@ -121,6 +123,9 @@ class Scene:
     duration: float
     rate: float
     warnings: tuple = ()
+    engine: str = 'newton_euler'
+    contacts: object = None
+    payload: tuple = None   # (mass, com, inertia, link) as given
 
     def wrench_at(self, t):
         """
@@ -233,7 +238,7 @@ def _gravity(value, model, w):
 
 
 def _payload(block, model, w):
-    """Return the model carrying the ``payload`` block's rigid body."""
+    """Return the model carrying the ``payload`` block's body, and it."""
     if not isinstance(block, dict):
         raise RobotFileError(f'{w}.payload: must give mass, com, inertia')
     _check_keys(block, {'mass', 'com', 'inertia', 'link'}, f'{w}.payload')
@@ -250,7 +255,8 @@ def _payload(block, model, w):
     if link is not None and not isinstance(link, str):
         raise RobotFileError(f'{w}.payload.link: must be a link name')
     try:
-        return with_payload(model, mass, com, inertia, link)
+        return (with_payload(model, mass, com, inertia, link),
+                (mass, np.array(com), inertia, link))
     except ValueError as exc:       # no end effector, or no such link
         raise RobotFileError(f'{w}.payload: {exc}') from None
 
@@ -282,8 +288,9 @@ def _effects(eff, model, origin):
     if not isinstance(velocity, bool):
         raise RobotFileError(f'{w}.velocity_products: must be true or false')
     payload_on, block = _flag_or_block(eff.get('payload'), f'{w}.payload')
+    payload = None
     if payload_on:
-        model = _payload(block, model, w)
+        model, payload = _payload(block, model, w)
     wrench_on, block = _flag_or_block(eff.get('wrench'), f'{w}.wrench')
     wrench = None
     if wrench_on:
@@ -305,7 +312,8 @@ def _effects(eff, model, origin):
     effects = Effects(gravity, velocity, payload_on, wrench_on, friction_on,
                       armature_on)
     return model, effects, {'viscous': viscous, 'coulomb': coulomb,
-                            'armature': armature, 'wrench': wrench}
+                            'armature': armature, 'wrench': wrench,
+                            'payload': payload}
 
 
 def _initial(init, n, origin):
@@ -373,10 +381,26 @@ def scene_from_dict(data, origin, base_dir='.'):
     name = data['name']
     if not isinstance(name, str) or not name:
         raise RobotFileError(f'{origin}: name: must be a non-empty string')
+    engine = data.get('engine', 'newton_euler')
+    if engine not in ENGINES:
+        raise RobotFileError(f'{origin}: engine: must be one of '
+                             f'{", ".join(ENGINES)}, got {_short(engine)!r}')
+    contacts = None
+    if data.get('contacts') is not None:
+        if engine != 'mujoco':
+            raise RobotFileError(f'{origin}: contacts: need engine: mujoco '
+                                 f'(the library simulates no contacts)')
+        from .contacts import read_contacts
+        contacts = read_contacts(data['contacts'], f'{origin}: contacts')
+    if engine == 'mujoco' and not effects.velocity_products:
+        raise RobotFileError(f'{origin}: effects.velocity_products: MuJoCo '
+                             f'always has them (engine: mujoco simulates '
+                             f'every rigid-body effect)')
     return Scene(name=name, description=str(data.get('description', '')),
                  path=origin, robot_path=robot_path, model=model,
                  effects=effects, q0=q0, qd0=qd0, reference=reference,
-                 warnings=tuple(found), **extras, **controller, **integrator)
+                 warnings=tuple(found), engine=engine, contacts=contacts,
+                 **extras, **controller, **integrator)
 
 
 def scene_dirs():

@@ -201,9 +201,14 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
     :func:`tracking_controller` (with ``feedforward`` and
     ``feedforward_at``, 'desired' or 'measured'); torques are held
     constant over each step (as a digital controller would).
-    ``progress`` shows a progress bar.
+    ``progress`` shows a progress bar.  A scene with ``engine: mujoco``
+    runs in MuJoCo (:func:`.mujoco_scene.simulate_mujoco`).
     """
     check_feedforward_at(feedforward_at)
+    if scene.engine == 'mujoco':
+        from .mujoco_scene import simulate_mujoco
+        return simulate_mujoco(scene, duration, controller, feedforward,
+                               step, feedforward_at)
     dyn = SceneDynamics(scene)
     control = controller or tracking_controller(dyn, feedforward,
                                                 feedforward_at)
