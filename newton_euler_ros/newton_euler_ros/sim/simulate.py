@@ -34,6 +34,7 @@ import numpy as np
 from .scene import INTEGRATORS
 from ..core.dynamics import jacobian, link_poses
 from ..core.effects import EffectDynamics
+from ..core.errors import DynamicsInputError
 
 
 def pd_torque(scene, q_d, qd_d, q, qd):
@@ -191,6 +192,31 @@ class SimulationResult:
         return self.energy - self.energy[0] - self.work.sum(axis=1)
 
 
+class IntegrationDiverged(DynamicsInputError):
+    """The state grew without bound: the step is too long for the gains."""
+
+
+def diverged(scene, method, dt, t):
+    """
+    Return the error of an integration that diverged at time ``t``.
+
+    It names the time step and the largest gains, with their joints.
+    """
+    names = scene.model.joint_names
+    i, j = int(np.argmax(scene.kp)), int(np.argmax(scene.kd))
+    return IntegrationDiverged(
+        f'{scene.name}: the integration diverged at t = {t:.4g} s '
+        f'({method}, time step {dt:g} s, gains kp up to '
+        f'{scene.kp[i]:g} ({names[i]}) and kd up to {scene.kd[j]:g} '
+        f'({names[j]})): use a smaller integrator step or lower '
+        f'controller gains')
+
+
+def _close(bar):
+    if bar is not None:
+        bar.close()
+
+
 def simulate(scene, duration=None, controller=None, feedforward=None,
              integrator=None, step=None, progress=False,
              feedforward_at='desired'):
@@ -243,28 +269,38 @@ def simulate(scene, duration=None, controller=None, feedforward=None,
         raise ValueError(f'integrator must be one of '
                          f'{", ".join(INTEGRATORS)}, got {method!r}')
     start = time.perf_counter()
-    for k in range(steps + 1):
-        t = k * dt
-        out_q[k], out_qd[k] = q, qd
-        out_ref[k] = scene.reference.at(t)[0]
-        out_e[k] = dyn.energy(q, qd)
-        out_w[k] = work
-        if k == steps:
-            break
-        tau, ff = control(t, q, qd)
-        out_tau[k], out_ff[k] = tau, ff
-        q, qd, w = advance(
-            method,
-            lambda t, q, qd: dyn.accelerations(q, qd, tau,
-                                               *scene.wrench_at(t)),
-            q, qd, t, dt,
-            lambda t, q, qd: np.array(dyn.power(q, qd, tau,
-                                                *scene.wrench_at(t))))
-        work = work + w
-        if bar is not None:
-            bar.update(1)
-    if bar is not None:
-        bar.close()
+    # a diverging integration overflows: said once, as such (below)
+    with np.errstate(over='ignore', invalid='ignore'):
+        for k in range(steps + 1):
+            t = k * dt
+            out_q[k], out_qd[k] = q, qd
+            out_ref[k] = scene.reference.at(t)[0]
+            try:
+                out_e[k] = dyn.energy(q, qd)
+                out_w[k] = work
+                if k == steps:
+                    break
+                tau, ff = control(t, q, qd)
+                out_tau[k], out_ff[k] = tau, ff
+                q, qd, w = advance(
+                    method,
+                    lambda t, q, qd: dyn.accelerations(
+                        q, qd, tau, *scene.wrench_at(t)),
+                    q, qd, t, dt,
+                    lambda t, q, qd: np.array(dyn.power(
+                        q, qd, tau, *scene.wrench_at(t))))
+            except DynamicsInputError:
+                if k == 0:          # the scene's own start: its inputs
+                    raise
+                _close(bar)
+                raise diverged(scene, method, dt, t) from None
+            if not (np.isfinite(q).all() and np.isfinite(qd).all()):
+                _close(bar)
+                raise diverged(scene, method, dt, t + dt)
+            work = work + w
+            if bar is not None:
+                bar.update(1)
+    _close(bar)
     out_tau[-1], out_ff[-1] = out_tau[-2], out_ff[-2]
     wall = time.perf_counter() - start
     result = SimulationResult(out_t, out_q, out_qd, out_tau, out_ff, out_ref,

@@ -244,3 +244,23 @@ def test_numba_cache_is_not_written_into_the_source_tree(tmp_path):
     assert cache == str(tmp_path / 'newton_euler_ros' / 'numba')
     assert any(name.endswith('.nbi') for _, _, files in os.walk(cache)
                for name in files)
+
+
+def test_simulate_says_a_diverging_integration_diverged(tmp_path):
+    """Stiff gains on a light wrist: the step and gains, not 'overflows'."""
+    import yaml
+    scene = yaml.safe_load(open(os.path.join(
+        os.path.dirname(__file__), '..', '..', 'config', 'scenes',
+        'panda_orbit_slow.yaml')))
+    scene['controller']['kp'][-1] = 1e6
+    scene['controller']['kd'][-1] = 1e4
+    scene['integrator']['duration'] = 0.5
+    path = tmp_path / 'stiff.yaml'
+    path.write_text(yaml.safe_dump(scene))
+    code, out, err = run('simulate', str(path))
+    assert code == 2 and out == ''
+    assert err == ('newton-euler: error: panda_orbit_slow: the integration '
+                   'diverged at t = 0.006 s (rk4, time step 0.002 s, gains '
+                   'kp up to 1e+06 (joint7) and kd up to 10000 (joint7)): '
+                   'use a smaller integrator step or lower controller '
+                   'gains\n')
