@@ -15,7 +15,7 @@
 """The benchmarks run end to end; their arithmetic is right (not timings)."""
 import json
 
-from newton_euler_tools import bench, bench_scaling
+from newton_euler_tools import bench, bench_mujoco, bench_scaling
 import numpy as np
 import pytest
 
@@ -69,3 +69,14 @@ def test_benchmark_runs(tmp_path):
     assert tree['valid'] is True
     assert {op for op, v in tree['verdicts'].items()
             if v['verdict'] in ('PASS', 'MISS')} == {'tau', 'D', 'FD'}
+
+
+def test_mujoco_plant_benchmark_runs(tmp_path):
+    # a short run: the table and the JSON, every factor a positive number
+    # (timings are not judged here)
+    out = tmp_path / 'mujoco.json'
+    assert bench_mujoco.main(['--seconds', '0.05', '--rounds', '1',
+                              '--json', str(out)]) == 0
+    data = json.loads(out.read_text())
+    rtf = data['real_time_factor']
+    assert len(rtf) == 3 and all(v > 0 for v in rtf.values())
