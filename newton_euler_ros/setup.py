@@ -73,6 +73,7 @@ setup(
             'inverse_dynamics_node = '
             'newton_euler_ros.nodes.entry:inverse_dynamics_node',
             'robot_sim_node = newton_euler_ros.nodes.entry:robot_sim_node',
+            'mujoco_sim_node = newton_euler_ros.nodes.entry:mujoco_sim_node',
             'tracking_controller_node = '
             'newton_euler_ros.nodes.entry:tracking_controller_node',
         ],

@@ -16,11 +16,11 @@
 Node parameters from one schema file per node, without ROS.
 
 ``<node>_parameters.yaml`` beside this module (inverse_dynamics,
-robot_sim, tracking_controller) lists every parameter of that node with
-its type, default, description, ``read_only`` flag and validation rules,
-in the style of generate_parameter_library.  This module reads it,
-validates values and renders the README table; each node declares its
-parameters from the same :class:`ParameterSpec` list
+robot_sim, tracking_controller, mujoco_sim) lists every parameter of that
+node with its type, default, description, ``read_only`` flag and
+validation rules, in the style of generate_parameter_library.  This
+module reads it, validates values and renders the README table; each
+node declares its parameters from the same :class:`ParameterSpec` list
 (:func:`..nodes.common.declare_parameters`).
 
     python -m newton_euler_ros.parameters --markdown [NODE]
@@ -38,11 +38,13 @@ import textwrap
 import yaml
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-NODES = ('inverse_dynamics_node', 'robot_sim_node', 'tracking_controller_node')
+NODES = ('inverse_dynamics_node', 'robot_sim_node', 'tracking_controller_node',
+         'mujoco_sim_node')
 #: each node's reference page (topics, parameters), in the repository
 NODE_PAGES = {'inverse_dynamics_node': 'docs/node.md',
               'robot_sim_node': 'docs/scenes-and-demos.md',
-              'tracking_controller_node': 'docs/scenes-and-demos.md'}
+              'tracking_controller_node': 'docs/scenes-and-demos.md',
+              'mujoco_sim_node': 'docs/node.md'}
 
 
 def schema_path(node_name):

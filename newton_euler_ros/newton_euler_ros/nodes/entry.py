@@ -55,6 +55,11 @@ def inverse_dynamics_node():
                 'newton_euler_ros.nodes.inverse_dynamics_node')
 
 
+def mujoco_sim_node():
+    """Run mujoco_sim_node."""
+    return _run('mujoco_sim_node', 'newton_euler_ros.nodes.mujoco_sim_node')
+
+
 def robot_sim_node():
     """Run robot_sim_node."""
     return _run('robot_sim_node', 'newton_euler_ros.nodes.robot_sim_node')

@@ -1,0 +1,425 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+mujoco_sim_node as a process: the MuJoCo plant over real DDS.
+
+- With no command the Panda holds its initial pose (brakes on); after a
+  command of zeros it falls exactly as MuJoCo's own simulation of the
+  same robot does, run here offline from the same state (to 1e-9: the
+  stepping is deterministic).
+- A one-joint URDF's ``<dynamics damping friction>`` reach the plant: a
+  torque below the Coulomb friction barely creeps (MuJoCo's friction loss
+  is a soft constraint), one above it moves the joint at the terminal
+  speed (tau - friction) / damping.  The robot comes from the latched
+  ``robot_description`` here.  Bad commands (wrong length, NaN, inf) are
+  counted in /diagnostics and not obeyed; a stale command gives zero
+  effort, said once, and again once when commands resume.
+- PD plus the library's g(q), computed here and sent over the topic at
+  250 Hz, holds the Panda at a pose to a millimetre and a milliradian:
+  gravity, joint order and units agree between the library and MuJoCo.
+- An MJCF bar falls onto a floor: its contact wrench on
+  ``~/contact_wrenches/bar`` (world axes, about the link's origin) holds
+  it up against gravity at rest.
+- A bad robot_file or a wrong number of initial positions: one line, exit
+  status 2.
+"""
+import math
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+pytest.importorskip('rclpy')
+pytest.importorskip('mujoco')
+
+# After the skips: pytest must be imported first, hence E402 and I100.
+from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
+from newton_euler_ros.core import (end_effector_pose,  # noqa: E402
+                                   gravity_torques, load_robot,
+                                   mass_matrix)
+from newton_euler_ros.sim.mujoco_model import load_mujoco  # noqa: E402
+from newton_euler_ros.sim.mujoco_plant import MujocoPlant  # noqa: E402
+from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
+                       ReliabilityPolicy)
+from ros_harness import domain_id, NodeProcess, Probe, ros_env  # noqa: E402
+from rosgraph_msgs.msg import Clock  # noqa: E402
+from sensor_msgs.msg import JointState  # noqa: E402
+from std_msgs.msg import Float64MultiArray, String  # noqa: E402
+import yaml  # noqa: E402
+
+pytestmark = pytest.mark.ros
+
+COMMANDS = 'effort_controller/commands'
+START = 60.0        # s: start-up on a loaded 2-core machine (MuJoCo, numba)
+# the Panda away from its joint limits, its links off the vertical
+Q0 = [0.3, -0.4, 0.2, -2.0, 0.3, 1.7, 0.5]
+# one joint about the vertical axis (no gravity torque): inertia about
+# the axis 0.03 + 1 * 0.1^2 = 0.04 kg m^2
+DAMPING, FRICTION = 2.0, 1.0
+ONE_JOINT = (
+    '<robot name="one"><link name="base"/>'
+    '<link name="arm"><inertial><origin xyz="0.1 0 0"/>'
+    '<mass value="1.0"/><inertia ixx="0.01" iyy="0.02" izz="0.03" ixy="0" '
+    'ixz="0" iyz="0"/></inertial></link>'
+    '<joint name="j1" type="revolute"><parent link="base"/>'
+    '<child link="arm"/><axis xyz="0 0 1"/>'
+    '<limit lower="-3" upper="3" effort="7" velocity="5"/>'
+    f'<dynamics damping="{DAMPING}" friction="{FRICTION}"/></joint>'
+    '</robot>')
+
+
+def node_cmd(tmp_path, **params):
+    """Return the console script's command with a params file."""
+    path = tmp_path / 'mujoco_sim.yaml'
+    path.write_text(yaml.safe_dump(
+        {'mujoco_sim_node': {'ros__parameters': params}}))
+    script = os.path.join(os.path.dirname(sys.executable), 'mujoco_sim_node')
+    base = [script] if os.path.exists(script) else [
+        sys.executable, '-m', 'newton_euler_ros.nodes.mujoco_sim_node']
+    return base + ['--ros-args', '--params-file', str(path)]
+
+
+def t_of(msg):
+    return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+def command(values):
+    return Float64MultiArray(data=[float(v) for v in values])
+
+
+def diagnostics_values(msg):
+    return {kv.key: kv.value for kv in msg.status[0].values}
+
+
+class Session:
+    """The node under test and a probe talking to it."""
+
+    def __init__(self, tmp_path, offset, **params):
+        self.domain = domain_id(offset)
+        self.node = NodeProcess(node_cmd(tmp_path, **params), self.domain,
+                                str(tmp_path / 'mujoco_sim_node.log'))
+        self.probe = Probe(self.domain, name='mujoco_probe')
+        self.states = self.probe.collect(JointState, 'joint_states', 1000)
+        self.diagnostics = self.probe.collect(DiagnosticArray,
+                                              '/diagnostics', 10)
+        self.pub = self.probe.publisher(Float64MultiArray, COMMANDS)
+
+    def wait_up(self, count=2):
+        """Wait for states, and for the node to hear the commands."""
+        assert self.probe.spin_until(
+            lambda: len(self.states) >= count
+            and self.pub.get_subscription_count() > 0, START), \
+            self.node.log()
+
+    def wait_states(self, count, timeout=30.0):
+        assert self.probe.spin_until(lambda: len(self.states) >= count,
+                                     timeout), self.node.log()
+
+    def wait_time(self, t, timeout=30.0):
+        """Spin until a state stamped t or later; return its index."""
+        assert self.probe.spin_until(
+            lambda: self.states and t_of(self.states[-1]) >= t - 1e-9,
+            timeout), self.node.log()
+        return next(k for k, m in enumerate(self.states)
+                    if t_of(m) >= t - 1e-9)
+
+    def drive(self, effort, duration, every=0.01, bad=()):
+        """
+        Send ``effort`` every ``every`` s of simulated time for ``duration``.
+
+        ``bad`` commands are sent too, half-way.  Return the index of the
+        first state after the first command was sent.
+        """
+        start = len(self.states)
+        self.wait_states(start + 1)
+        t0 = t_of(self.states[-1])
+        sent = -math.inf
+        first = None
+        while True:
+            t = t_of(self.states[-1])
+            if t >= t0 + duration:
+                return first
+            if t >= sent + every:
+                self.pub.publish(command(effort))
+                sent = t
+                if first is None:
+                    first = len(self.states)
+            if bad and t >= t0 + duration / 2:
+                for values in bad:
+                    self.pub.publish(Float64MultiArray(data=values))
+                bad = ()
+            count = len(self.states)
+            assert self.probe.spin_until(lambda: len(self.states) > count,
+                                         10.0), self.node.log()
+
+    def last_diagnostics(self, predicate, timeout=10.0):
+        """Return the values of the first diagnostics that ``predicate``."""
+        def found():
+            return next((v for v in map(diagnostics_values,
+                                        self.diagnostics) if predicate(v)),
+                        None)
+        self.probe.spin_until(lambda: found() is not None, timeout)
+        values = found()
+        assert values is not None, (
+            [diagnostics_values(m) for m in self.diagnostics[-3:]],
+            self.node.log())
+        return values
+
+    def close(self):
+        self.probe.close()
+        status = self.node.stop()
+        log = self.node.log()
+        assert status == 0, log
+        assert 'Traceback' not in log, log
+        return log
+
+
+def test_holds_then_falls_as_mujoco_does(tmp_path):
+    run = Session(tmp_path, 41, robot_file='panda',
+                  initial_positions=Q0, rate=500.0)
+    clock = run.probe.collect(Clock, '/clock', 10)
+    try:
+        run.wait_up(50)
+        # 1. brakes on: exactly the initial pose, no effort, time runs
+        for msg in run.states:
+            assert list(msg.name) == [f'joint{i}' for i in range(1, 8)]
+            np.testing.assert_array_equal(msg.position, Q0)
+            np.testing.assert_array_equal(msg.velocity, 0.0)
+            np.testing.assert_array_equal(msg.effort, 0.0)
+        stamps = np.array([t_of(m) for m in run.states])
+        np.testing.assert_allclose(np.diff(stamps), 0.002, atol=1e-6)
+        assert clock, 'no /clock'
+        held = run.last_diagnostics(lambda v: v['held'] == 'true')
+        assert held['commands received'] == '0'
+
+        # 2. a command of zeros releases the brakes: the arm falls
+        run.pub.publish(command(np.zeros(7)))
+        ticks = 200
+
+        def release():
+            return next((k for k, m in enumerate(run.states)
+                         if not np.array_equal(m.position, Q0)), None)
+        assert run.probe.spin_until(
+            lambda: release() is not None
+            and len(run.states) > release() + ticks, 30.0), run.node.log()
+        r = release()
+        after = run.states[r - 1:r + ticks]
+        np.testing.assert_allclose(
+            np.diff([t_of(m) for m in after]), 0.002, atol=1e-6)
+        last_clock = clock[-1].clock
+        assert last_clock.sec + last_clock.nanosec * 1e-9 >= t_of(after[-1])
+    finally:
+        log = run.close()
+    assert 'brakes released' in log, log
+
+    # MuJoCo's own simulation of the same robot from the same state
+    plant = MujocoPlant(load_mujoco('panda', timestep=0.001), Q0)
+    plant.release()
+    fell = 0.0
+    for j in range(ticks):
+        plant.advance(np.zeros(7), 0.002)
+        if j in (0, 1, 9, 49, 99, ticks - 1):
+            q, qd = plant.state()
+            msg = after[j + 1]
+            np.testing.assert_allclose(msg.position, q, rtol=0, atol=1e-9,
+                                       err_msg=f'tick {j + 1}')
+            np.testing.assert_allclose(msg.velocity, qd, rtol=0,
+                                       atol=1e-9, err_msg=f'tick {j + 1}')
+            np.testing.assert_array_equal(msg.effort, 0.0)
+            fell = np.abs(q - Q0).max()
+    assert fell > 0.05          # it did fall: 0.4 s without torques
+
+
+def test_damping_friction_bad_and_stale_commands(tmp_path):
+    run = Session(tmp_path, 43, rate=500.0, command_timeout=0.5)
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    description = run.probe.node.create_publisher(
+        String, 'robot_description', latched)
+    description.publish(String(data=ONE_JOINT))
+    try:
+        run.wait_up(20)
+        assert list(run.states[-1].name) == ['j1']
+
+        # 1. bad commands while held: counted, and the brakes stay on
+        for values in ([1.0, 2.0], [math.nan], [math.inf], []):
+            run.pub.publish(Float64MultiArray(data=values))
+        values = run.last_diagnostics(
+            lambda v: v.get('bad commands ignored') == '4')
+        assert values['held'] == 'true' and \
+            values['commands received'] == '0', values
+        assert all(m.position[0] == 0.0 for m in run.states)
+
+        # 2. below the Coulomb friction: it barely creeps (MuJoCo's
+        # friction loss is a soft constraint: 0.0125 rad/s here); without
+        # friction it would reach 0.5 / DAMPING = 0.25 rad/s
+        k = run.drive([0.5], 0.5)
+        below = run.states[k + 5:]
+        assert all(m.effort[0] == 0.5 for m in below)
+        assert max(abs(m.velocity[0]) for m in below) < 0.1 * 0.25
+        assert abs(below[-1].position[0]) < 0.02
+
+        # 3. above it: terminal speed (tau - friction) / damping; the bad
+        # commands sent half-way are not obeyed
+        k = run.drive([3.0], 0.6, bad=([math.nan], [5.0, 5.0]))
+        above = run.states[k + 5:]
+        assert all(m.effort[0] == 3.0 for m in above), \
+            sorted({m.effort[0] for m in above})
+        speed = (3.0 - FRICTION) / DAMPING
+        assert abs(above[-1].velocity[0] - speed) < 0.02 * speed, \
+            above[-1].velocity[0]
+        last_sent = t_of(run.states[-1])
+
+        # 4. no new command: zero effort after command_timeout of
+        # simulated time (the joint then stops)
+        k = run.wait_time(last_sent + 0.7)
+        zero = next(m for m in run.states[-400:] if m.effort[0] == 0.0)
+        assert 0.45 <= t_of(zero) - last_sent <= 0.55, t_of(zero) - last_sent
+        assert abs(run.states[k].velocity[0]) < 0.05
+        assert all(m.effort[0] == 0.0 for m in run.states[k - 50:k + 1])
+        run.drive([0.0], 0.05)
+        values = run.last_diagnostics(
+            lambda v: v.get('bad commands ignored') == '6'
+            and v.get('stale periods') == '1' and v.get('stale') == 'false')
+        assert values['held'] == 'false'
+        assert int(values['commands received']) > 100
+    finally:
+        log = run.close()
+    assert log.count('command ignored') >= 1
+    assert log.count('zero effort until the next one') == 1, log
+    assert log.count('commands resumed') == 1, log
+
+
+def test_pd_plus_the_library_gravity_holds_a_pose(tmp_path):
+    model = load_robot('panda')
+    target = np.array(Q0)
+    start = target + np.array([0.04, -0.05, 0.05, 0.04, -0.05, 0.05, 0.05])
+    # per-joint gains for about 10 rad/s, damped: without the gravity
+    # torques the arm would sag by g / kp, tenths of a radian at the
+    # shoulder
+    m = np.diag(mass_matrix(model, target))
+    kp, kd = 100.0 * m, 14.0 * m
+    g_target = gravity_torques(model, target)
+    assert np.abs(g_target / kp).max() > 0.05
+    run = Session(tmp_path, 47, robot_file='panda',
+                  initial_positions=start.tolist(), rate=250.0)
+    sent = []
+
+    def control(msg):
+        q, qd = np.array(msg.position), np.array(msg.velocity)
+        tau = gravity_torques(model, q) + kp * (target - q) - kd * qd
+        run.pub.publish(command(tau))
+        sent.append(t_of(msg))
+    try:
+        run.wait_up(5)
+        names = list(run.states[-1].name)
+        assert names == list(model.joint_names), names
+        run.probe.node.create_subscription(JointState, 'joint_states',
+                                           control, 10)
+        assert run.probe.spin_until(lambda: len(sent) > 10, 20.0), \
+            run.node.log()
+        t_end = sent[0] + 3.0
+        run.wait_time(t_end, timeout=60.0)
+        window = [msg for msg in run.states
+                  if t_end - 0.5 <= t_of(msg) <= t_end]
+        assert len(window) > 100
+        tip = end_effector_pose(model, target)[:3, 3]
+        for msg in window:
+            q = np.array(msg.position)
+            assert np.abs(q - target).max() < 1e-3, q - target
+            assert np.linalg.norm(end_effector_pose(model, q)[:3, 3]
+                                  - tip) < 1e-3
+        # the effort the plant applied is the library's g at the pose
+        np.testing.assert_allclose(window[-1].effort, g_target, atol=0.05)
+        values = run.last_diagnostics(lambda v: v['held'] == 'false')
+        assert values['bad commands ignored'] == '0', values
+    finally:
+        run.close()
+    # the test kept up: commands at the plant's rate, 250 Hz
+    gaps = np.diff(sent)
+    assert np.median(gaps) < 0.0045, np.median(gaps)
+
+
+# a bar hinged 0.3 m above a floor, its axis y, falls onto the floor
+BAR = """\
+<mujoco model="bar">
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 0.1"/>
+    <body name="base" pos="0 0 0.3">
+      <body name="bar">
+        <joint name="hinge" type="hinge" axis="0 1 0" damping="0.5"/>
+        <inertial pos="0.25 0 0" mass="1" diaginertia="0.001 0.02 0.02"/>
+        <geom type="capsule" fromto="0 0 0 0.5 0 0" size="0.02"/>
+      </body>
+    </body>
+  </worldbody>
+  <actuator><motor joint="hinge" name="hinge"/></actuator>
+</mujoco>
+"""
+
+
+def test_contact_wrench_of_a_bar_resting_on_the_floor(tmp_path):
+    """
+    An MJCF bar falls onto a floor; at rest its contact wrench holds it.
+
+    Static, no motor torque: about the hinge (the bar's origin) the
+    floor's moment cancels gravity's, -m g 0.25 cos q about y.
+    """
+    from geometry_msgs.msg import WrenchStamped
+    path = tmp_path / 'bar.xml'
+    path.write_text(BAR)
+    run = Session(tmp_path, 53, robot_file=str(path), rate=250.0)
+    wrenches = run.probe.collect(
+        WrenchStamped, '/mujoco_sim_node/contact_wrenches/bar', 1000)
+    try:
+        run.wait_up(5)
+        run.drive([0.0], 1.2, every=0.1)
+        assert wrenches, run.node.log()
+        last = wrenches[-1]
+        assert last.header.frame_id == 'base'
+        state = next(m for m in run.states if m.header.stamp ==
+                     last.header.stamp)
+        q = state.position[0]
+        assert 0.5 < q < 0.7 and abs(state.velocity[0]) < 1e-3, q
+        f, n = last.wrench.force, last.wrench.torque
+        weight = 9.81
+        np.testing.assert_allclose(n.y, -weight * 0.25 * math.cos(q),
+                                   rtol=1e-3)
+        assert abs(n.x) < 1e-6 and abs(n.z) < 1e-6 and abs(f.y) < 1e-6
+        # the hinge and the floor share the weight: by moments about the
+        # tip, the floor takes half of it
+        assert abs(f.z - weight / 2) < 0.01 * weight, f.z
+    finally:
+        run.close()
+
+
+@pytest.mark.parametrize('params, message', [
+    ({'robot_file': '/no/such/robot.urdf'},
+     'robot_file: /no/such/robot.urdf: cannot read'),
+    ({'robot_file': 'panda', 'initial_positions': [0.1, 0.2]},
+     'initial_positions: 7 values expected'),
+])
+def test_configuration_errors_are_one_line(tmp_path, params, message):
+    proc = subprocess.run(node_cmd(tmp_path, **params),
+                          env=ros_env(domain_id(49)), capture_output=True,
+                          text=True, timeout=90)
+    assert proc.returncode == 2, proc.stderr
+    lines = [line for line in proc.stderr.splitlines()
+             if not line.startswith('[')]
+    assert lines == [f'mujoco_sim_node: invalid configuration: '
+                     f'{lines[0].split(": ", 2)[-1]}'], proc.stderr
+    assert message in lines[0], proc.stderr
