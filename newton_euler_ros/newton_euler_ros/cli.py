@@ -52,6 +52,8 @@ import numpy as np  # noqa: E402 (after the BLAS thread count)
 from .cli_identify import register as register_identify  # noqa: E402
 from .cli_loop import register as register_loop  # noqa: E402
 from .cli_observe import register as register_observe  # noqa: E402
+from .cli_report import (format_table, mass_counted,  # noqa: E402
+                         source, tree_lines, types_of)
 from .cli_ros import (register as register_ros, RosCliError,  # noqa: E402
                       RosGraphError)
 from .core import (coriolis_matrix, gravity_torques,  # noqa: E402
@@ -176,40 +178,6 @@ def _load_states(path, n):
     return out
 
 
-def _fmt(x, width=13):
-    return f'{x:>{width}.6g}'
-
-
-def _matrix_lines(title, names, M, col_names=None):
-    col_names = col_names or names
-    w = max(12, *(len(x) for x in names))       # names are never cut
-    cw = max(13, *(len(c) + 1 for c in col_names))
-    lines = [title, ' ' * (w + 2) + ''.join(f'{c:>{cw}}' for c in col_names)]
-    for name, row in zip(names, M):
-        lines.append(f'  {name:<{w}}' + ''.join(_fmt(v, cw) for v in row))
-    return lines
-
-
-def _source(model):
-    if model.is_dh:
-        return f'{model.convention} DH'
-    report = model.info.get('urdf', {})
-    if report.get('tree'):
-        mimic = len(report.get('mimic', ()))
-        return (f'URDF tree below {report.get("base", "?")} ('
-                + (f'one tip, {report["tip"]}' if report.get('tip') else
-                   'several tips')
-                + (f'; {model.nb} moving joints, {mimic} of them mimic'
-                   if mimic else '') + ')')
-    return (f'URDF chain {report.get("base", "?")} -> '
-            f'{report.get("tip", "?")}')
-
-
-def _types(model):
-    """Return the joint type of each coordinate (a tree's independent joints)."""
-    return [model.joint_types[b] for b in model.independent]
-
-
 def _warn(found):
     """Print warnings; notes about published data are for ``check``."""
     for message in found:
@@ -226,56 +194,6 @@ def _load(args):
         if 'link' in str(exc) and 'is not in the URDF' in str(exc):
             raise CliError(str(exc)) from None
         raise
-
-
-def format_table(model, result, q, qd, qdd, wrench, wrench_frame,
-                 link=None):
-    """Return a human-readable, multi-line report of one evaluation."""
-    names = result['joint_names']
-    types = _types(model)
-    D = np.array(result['mass_matrix'])
-    C = np.array(result['coriolis_matrix'])
-    g = np.array(result['gravity'])
-    J = None if result['jacobian'] is None else np.array(result['jacobian'])
-    jtf = J.T @ wrench if wrench is not None else np.zeros(len(names))
-    lines = [f'{model.name}: {model.n} joints, {_source(model)}, '
-             f'gravity {model.gravity.tolist()} m/s^2 (base frame)']
-    where = 'end-effector' if link is None else f'{link!r}'
-    axes = wrench_frame if link is None or wrench_frame == 'base' else \
-        'its own'
-    if wrench is not None:
-        lines.append(f'{where} wrench (exerted by the robot, '
-                     f'{axes} axes): {wrench.tolist()}')
-    lines.append('')
-    head = ('joint', 'type', 'q', 'qd', 'qdd', 'D qdd', 'C qd', 'g',
-            'J^T F', 'tau')
-    w = max(12, *(len(x) + 1 for x in names))  # names are never cut
-    lines.append(f'{head[0]:<{w}}{head[1]:<10}' + ''.join(f'{h:>13}'
-                                                          for h in head[2:]))
-    for j, name in enumerate(names):
-        unit = 'N m' if types[j] == 'revolute' else 'N'
-        row = (q[j], qd[j], qdd[j], (D @ qdd)[j], (C @ qd)[j], g[j], jtf[j],
-               result['tau'][j])
-        lines.append(f'{name:<{w}}{types[j][:9]:<10}'
-                     + ''.join(_fmt(v) for v in row) + f'  {unit}')
-    lines.append('tau = D qdd + C qd + g + J^T F  (N m for revolute, '
-                 'N for prismatic joints)')
-    lines.append('')
-    lines += _matrix_lines('mass matrix D(q):', names, D)
-    lines.append('')
-    lines += _matrix_lines('Coriolis matrix C(q, qd) (Christoffel form):',
-                           names, C)
-    lines.append('')
-    rows = ['vx', 'vy', 'vz', 'wx', 'wy', 'wz']
-    if J is None:
-        lines.append('(no Jacobian: the tree has several tips; --link '
-                     'LINK names one)')
-    else:
-        origin = 'the end-effector origin' if link is None else \
-            f'the origin of {link!r}'
-        lines += _matrix_lines(f'Jacobian J(q) of {origin} ({axes} axes):',
-                               rows, J, names)
-    return '\n'.join(lines)
 
 
 def cmd_dynamics(args):
@@ -314,10 +232,11 @@ def cmd_dynamics(args):
 
 def cmd_check(args):
     model, found, path = _load(args)
-    types = ''.join('R' if t == 'revolute' else 'P' for t in _types(model))
+    # R revolute, C continuous, P prismatic
+    types = ''.join(t[0].upper() for t in types_of(model))
     print(f'{path}: OK')
     print(f'  name: {model.name}')
-    print(f'  joints: {model.n} ({types}), {_source(model)}')
+    print(f'  joints: {model.n} ({types}), {source(model)}')
     print(f'  joint names: {", ".join(model.joint_names)}')
     report = model.info.get('urdf')
     if report and report.get('tree'):       # the whole tree below base
@@ -338,7 +257,7 @@ def cmd_check(args):
               f'{", ".join(report.get("locked", ())) or "none"}')
         print(f'  continuous joints: '
               f'{", ".join(report["continuous"]) or "none"}')
-    print(f'  total mass: {model.total_mass:.6g} kg')
+    print(f'  total mass: {model.total_mass:.6g} kg ({mass_counted(model)})')
     print(f'  gravity: {model.gravity.tolist()} m/s^2')
     for line in describe_drives(model_drives(model), model.joint_names):
         print(f'  {line}')
@@ -347,35 +266,6 @@ def cmd_check(args):
     for message in found:
         print(f'  {"note" if message in notes else "warning"}: {message}')
     return 0
-
-
-def tree_lines(model, report):
-    """
-    Return the tree below the base, one joint a line, indented by depth.
-
-    Each line: the joint, its type (a mimic joint's multiplier, leader
-    and offset; a fixed joint merged into its parent's body) and the
-    link it carries.
-    """
-    depth = {report['base']: 0}
-    kinds = dict(zip(model.moving_joints, model.joint_types))
-    kinds.update((j, 'continuous') for j in report['continuous'])
-    base = report['base']
-    lines = [f"tree below {base} (depth first, each link's joints in URDF "
-             f"order: the model's joint order):",
-             f'  {report["base"]}']
-    for jname, link in zip(report['chain'], report['chain_links']):
-        d = depth[report['parent_links'][jname]] + 1
-        depth[link] = d
-        if jname in report['mimic']:
-            leader, mult, offset = report['mimic'][jname]
-            kind = (f'{kinds[jname]}, mimic: {mult:g} x {leader}'
-                    + (f' {"+" if offset >= 0 else "-"} {abs(offset):g}'
-                       if offset else ''))
-        else:
-            kind = kinds.get(jname, 'fixed, merged')
-        lines.append(f'{"  " * (d + 1)}{jname} ({kind}) -> {link}')
-    return lines
 
 
 def cmd_simulate(args):

@@ -758,7 +758,15 @@ def test_cli_check_prints_chain_merges_and_lumps(tmp_path):
             '            j3 (continuous) -> l3\n'
             '              flange (fixed, merged) -> tool0\n'
             '            grip (prismatic) -> finger\n') in out
-    assert 'joints: 4 (RPRP)' in out
+    # a continuous joint is listed as continuous, not revolute
+    assert 'joints: 4 (RPCP)' in out
+    assert ('total mass: ' in out and '(the links the joints move; world '
+            'and the links fixed to it not counted)' in out)
+    code, out, err = run_cli('dynamics', str(path), '--q', '0', '0', '0',
+                             '0')
+    assert code == 0, err
+    assert [line.split()[1] for line in out.splitlines()[3:7]] == [
+        'revolute', 'prismatic', 'continuous', 'prismatic']
 
 
 def test_float32_runs_the_same_kernels_on_a_urdf_model():

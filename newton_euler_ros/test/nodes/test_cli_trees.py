@@ -91,6 +91,40 @@ def test_dynamics_of_the_whole_tree_against_pinocchio(baxter):
     assert code == 2 and "closest: 'left_gripper'" in err
 
 
+def test_a_whole_robots_matrices_stay_readable(baxter):
+    """
+    D, C and J of 17 joints: blocks of numbered columns, 100 wide at most.
+
+    Every entry is still printed (as --json gives it).
+    """
+    path, model, _ = baxter
+    q = [str(0.1 * k) for k in range(model.n)]
+    code, out, err = run('dynamics', path, '--q', *q, '--qd', *q)
+    assert code == 0, err
+    code, js, err = run('dynamics', path, '--q', *q, '--qd', *q, '--json')
+    res = json.loads(js)
+    lines = out.splitlines()
+    start = lines.index('mass matrix D(q):')
+    assert max(len(line) for line in lines[start:]) <= 100
+    assert lines[start + 1] == ('  (columns: the joints numbered in order, '
+                                '5 to a block; --json gives it whole)')
+    for title, key in (('mass matrix D(q):', 'mass_matrix'),
+                       ('Coriolis matrix C(q, qd) (Christoffel form):',
+                        'coriolis_matrix')):
+        at = lines.index(title)
+        rows = {}
+        for line in lines[at + 2:]:
+            if not line.strip():
+                break
+            parts = line.split()
+            if parts[0].isdigit() and len(parts) > 1 and \
+                    parts[1] in model.joint_names:
+                rows.setdefault(parts[1], []).extend(map(float, parts[2:]))
+        assert list(rows) == list(model.joint_names)
+        np.testing.assert_allclose([rows[j] for j in model.joint_names],
+                                   res[key], rtol=1e-5, atol=1e-12)
+
+
 def test_check_prints_the_tree_by_depth(baxter):
     path, model, _ = baxter
     code, out, err = run('check', path)
