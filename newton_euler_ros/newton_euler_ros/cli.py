@@ -333,18 +333,20 @@ def cmd_feedforward(args):
     wrench = (np.array(_numbers(args.wrench, '--wrench'))
               if args.wrench is not None else None)
     wrench, frame = _at_link(model, wrench, args.wrench_frame, args.link)
-    hold = None
+    hold, left = None, []
     if (model.info.get('urdf') or {}).get('tree'):
         # a whole robot: the joints the trajectory leaves out stay at zero
         hold = np.zeros(model.n)
         names = trajectory.get('joint_names')
         left = [j for j in model.joint_names
                 if isinstance(names, list) and j not in names]
-        if left:
-            print(f'note: joints not in the trajectory held at 0, at rest: '
-                  f'{", ".join(left)}', file=sys.stderr)
-    print(json.dumps(fill_efforts(model, trajectory, wrench, frame,
-                                  where=f'{path}: ', hold=hold)))
+    # an error is the one line: the note only once the efforts are filled
+    filled = fill_efforts(model, trajectory, wrench, frame,
+                          where=f'{path}: ', hold=hold)
+    if left:
+        print(f'note: joints not in the trajectory held at 0, at rest: '
+              f'{", ".join(left)}', file=sys.stderr)
+    print(json.dumps(filled))
     return 0
 
 

@@ -181,6 +181,13 @@ def test_feedforward_of_one_arm_holds_the_others_at_zero(baxter, tmp_path):
         expected = peer.terms(x, 0 * x, 0 * x)['tau'][arm]
         np.testing.assert_allclose(point['effort'][::-1], expected, rtol=0,
                                    atol=1e-9)
+    # a trajectory that fails: its error is the one line, no note first
+    trajectory['points'][1]['positions'] = [0.0]
+    file.write_text(json.dumps(trajectory))
+    code, out, err = run('feedforward', path, file)
+    assert code == 2 and out == ''
+    assert err.count('\n') == 1 and err.startswith('newton-euler: error: '
+                                                    f'{file}: '), err
 
 
 def test_simulate_a_scene_of_the_whole_tree(baxter, tmp_path):
