@@ -212,6 +212,7 @@ def _page(name):
 
 
 NODE_PAGES = {'inverse_dynamics_node': 'docs/node.md',
+              'mujoco_sim_node': 'docs/node.md',
               'robot_sim_node': 'docs/scenes-and-demos.md',
               'tracking_controller_node': 'docs/scenes-and-demos.md'}
 
