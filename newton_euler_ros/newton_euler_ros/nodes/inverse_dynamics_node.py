@@ -310,6 +310,20 @@ class InverseDynamicsNode(SharedGraphNode):
                 f'dropped {source}: {clip(exc)} ({kind}: '
                 f'{self.counts[kind]} so far)')
 
+    def _expired(self, ff):
+        """Say a wrench expired: not dropped, no longer applied."""
+        self.counts['expired'] += 1
+        which = ('' if ff.merger is None else ' (' + clip(', '.join(
+            ff.wrench.last_expired), 200) + ')')
+        now = time.monotonic()
+        if now - self._last_log.get('expired', -1e300) >= self.log_throttle:
+            self._last_log['expired'] = now
+            self.get_logger().warning(
+                f'wrench expired: the last wrench{which} is older than '
+                f'wrench.timeout ({ff.wrench.timeout} s); the torques are '
+                f'computed without it until a new one arrives (expired: '
+                f'{self.counts["expired"]} so far)')
+
     def _no_model(self, _source):
         # said once at start-up and in /diagnostics; counted, not logged
         self.counts['no_model'] += 1
@@ -335,12 +349,7 @@ class InverseDynamicsNode(SharedGraphNode):
             # the torques left the wrench out once it was too old: say so
             # once, with the first state answered without it
             if ff.wrench.expire(now):
-                which = ('' if ff.merger is None else ' (' + clip(', '.join(
-                    ff.wrench.last_expired), 200) + ')')
-                self._reject('wrench', InputRejected(
-                    'expired', f'the last wrench{which} is older than '
-                    f'{ff.wrench.timeout} s; torques no longer include '
-                    f'it'))
+                self._expired(ff)
         except InputRejected as exc:
             if exc.kind == 'other_joints':
                 # another publisher on joint_states (a gripper driver's):

@@ -179,6 +179,13 @@ def test_expired_wrench_is_no_longer_applied(graph, model):
     cmd, _ = graph.send_state(q, qd)
     np.testing.assert_allclose(cmd, permute(inverse_dynamics(model, q, qd)),
                                rtol=0, atol=1e-12)
+    # said as expired, with what the node does, not as 'dropped'
+    log = graph.node.log()
+    assert (f'wrench expired: the last wrench is older than wrench.timeout '
+            f'({TIMEOUT} s); the torques are computed without it until a '
+            f'new one arrives (expired: ') in log, log
+    assert not [line for line in log.splitlines()
+                if 'dropped wrench' in line and 'older than' in line]
 
 
 def test_service_returns_dynamics_terms(graph, model):
