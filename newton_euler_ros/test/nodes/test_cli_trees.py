@@ -186,8 +186,8 @@ def test_feedforward_of_one_arm_holds_the_others_at_zero(baxter, tmp_path):
     file.write_text(json.dumps(trajectory))
     code, out, err = run('feedforward', path, file)
     assert code == 2 and out == ''
-    assert err.count('\n') == 1 and err.startswith('newton-euler: error: '
-                                                    f'{file}: '), err
+    assert err.count('\n') == 1, err
+    assert err.startswith(f'newton-euler: error: {file}: '), err
 
 
 def test_simulate_a_scene_of_the_whole_tree(baxter, tmp_path):
