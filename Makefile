@@ -6,6 +6,8 @@
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
 #   make demo-identify  excite, record, identify, payload (about a minute);
 #                out/demo_identify/
+#   make demo-identify-mujoco  the same loop offline on a Panda simulated by
+#                MuJoCo (about a minute); out/mujoco_identify/
 #   make bench   run the benchmarks (peers side by side; cost per effect;
 #                regressor, observer, identification time and memory)
 #   make bench-identify  identification time and memory (1 and 30 min bags)
@@ -42,7 +44,7 @@ unexport PYTHONDONTWRITEBYTECODE
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
 export NUMBA_CACHE_DIR ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/newton_euler_ros/numba
 
-.PHONY: setup test demo demo-pick demo-identify bench bench-identify latency \
+.PHONY: setup test demo demo-pick demo-identify demo-identify-mujoco bench bench-identify latency \
 	peers accuracy \
 	accuracy-quick colcon-check clean
 
@@ -60,6 +62,9 @@ demo-pick: setup
 
 demo-identify: setup
 	$(PY) -m newton_euler_tools.demo_identify
+
+demo-identify-mujoco: setup
+	$(PY) -m newton_euler_tools.mujoco_identify
 
 bench: setup
 	$(PY) -m newton_euler_tools.bench
