@@ -34,6 +34,17 @@ CONTROLLER_REMAPS = (
     ('~/commands', f'{SIM}/commands'),
 )
 
+# the same loop with MuJoCo as the plant (mujoco_sim_node), which takes
+# efforts where ros2_control's effort forward controller does
+MUJOCO_SIM = '/mujoco_sim_node'
+EFFORT_COMMANDS = '/effort_controller/commands'
+MUJOCO_CONTROLLER_REMAPS = (
+    ('~/start', f'{MUJOCO_SIM}/start'),
+    ('~/feedforward', f'{ID}/torques'),
+    ('~/reference', f'{ID}/reference'),
+    ('~/commands', EFFORT_COMMANDS),
+)
+
 
 #: (name in the node, launch argument, default, description) of the topics
 #: inverse_dynamics_node's launch files let a graph remap

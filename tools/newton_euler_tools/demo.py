@@ -39,12 +39,24 @@ import sys
 import time
 import warnings
 
-from newton_euler_ros.graph import CONTROLLER_REMAPS, ID, ros_args, SIM
+from newton_euler_ros.graph import (CONTROLLER_REMAPS, EFFORT_COMMANDS, ID,
+                                    MUJOCO_CONTROLLER_REMAPS, MUJOCO_SIM,
+                                    ros_args, SIM)
 import numpy as np
 
+from .demo_report import plots, summary, torque_terms
 from .processes import ChildProcess, first_domain
 
-SCENE = 'puma_payload_press'
+# the plant: its node, its start and command topics, the controller's
+# remaps, the default scene
+PLANTS = {
+    'mujoco': ('mujoco_sim_node', f'{MUJOCO_SIM}/start', EFFORT_COMMANDS,
+               MUJOCO_CONTROLLER_REMAPS, 'panda_mujoco_full'),
+    'newton_euler': ('robot_sim_node', f'{SIM}/start', f'{SIM}/commands',
+                     CONTROLLER_REMAPS, 'puma_payload_press'),
+}
+PLANT = 'mujoco'
+SCENE = PLANTS[PLANT][-1]
 QUICK_DURATION = 1.0
 STARTUP_TIMEOUT = 120.0     # first run may compile the numba kernels
 
@@ -106,7 +118,8 @@ class Recorder:
     """
 
     def __init__(self, domain, states_after_commands=False,
-                 name='demo_recorder'):
+                 name='demo_recorder', start=f'{SIM}/start',
+                 commands=f'{SIM}/commands'):
         import rclpy
         from rclpy.executors import SingleThreadedExecutor
         from rclpy.qos import (DurabilityPolicy, QoSProfile,
@@ -125,10 +138,9 @@ class Recorder:
         latched = QoSProfile(depth=1,
                              reliability=ReliabilityPolicy.RELIABLE,
                              durability=DurabilityPolicy.TRANSIENT_LOCAL)
-        self.node.create_subscription(Header, f'{SIM}/start', self._on_start,
-                                      latched)
+        self.node.create_subscription(Header, start, self._on_start, latched)
         self.cmd_sub = self.node.create_subscription(
-            Float64MultiArray, f'{SIM}/commands', self._on_command, 1000)
+            Float64MultiArray, commands, self._on_command, 1000)
         self._state_type = JointState
         self.state_sub = None
         self._states_after_commands = states_after_commands
@@ -209,11 +221,18 @@ def logged_count(child, what):
     return int(counts[what])
 
 
-def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
+def run_graph(scene_arg, label, feedforward, duration, domain, log_dir,
+              plant=PLANT):
     """Run the three nodes once; return the recorded arrays."""
     ff = 'true' if feedforward else 'false'
+    node, start, commands, remaps, _ = PLANTS[plant]
+    # MuJoCo's plant stamps in simulated time and publishes /clock: the
+    # others follow it (the library's own simulator stamps in wall time)
+    sim_time = (['-p', 'use_sim_time:=true'] if plant == 'mujoco'
+                else [])
     children = []
-    recorder = Recorder(domain, states_after_commands=True)
+    recorder = Recorder(domain, states_after_commands=True, start=start,
+                        commands=commands)
     status = {}
     try:
         # The simulator starts its clock once every node has discovered its
@@ -225,27 +244,27 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir):
         # node); the simulator's GRACE second covers the ID node's side.
         # The controller starts last.
         sim = Child(
-            f'{label}_robot_sim_node', 'newton_euler_ros.nodes.'
-            'robot_sim_node', ['-p', f'scene:={scene_arg}',
-                               '-p', 'wait_for_subscribers:=3'],
+            f'{label}_{node}', f'newton_euler_ros.nodes.{node}',
+            ['-p', f'scene:={scene_arg}', '-p', 'wait_for_subscribers:=3'],
             domain, log_dir)
         children.append(sim)
         children.append(Child(
             f'{label}_inverse_dynamics_node',
             'newton_euler_ros.nodes.inverse_dynamics_node',
             ['-p', f'scene:={scene_arg}',
-             '-p', 'acceleration_source:=reference'], domain, log_dir))
+             '-p', 'acceleration_source:=reference', *sim_time], domain,
+            log_dir))
         wait_for(recorder, children,
                  lambda: recorder.publishers(f'{ID}/torques') >= 1
-                 and recorder.subscribers(f'{SIM}/commands') >= 1,
-                 'robot_sim_node and inverse_dynamics_node')
+                 and recorder.subscribers(commands) >= 1,
+                 f'{node} and inverse_dynamics_node')
         controller = Child(
             f'{label}_tracking_controller_node',
             'newton_euler_ros.nodes.tracking_controller_node',
             ['-p', f'scene:={scene_arg}', '-p', f'feedforward:={ff}',
              # the simulator and this recorder
-             '-p', 'wait_for_subscribers:=2',
-             *ros_args(CONTROLLER_REMAPS)], domain, log_dir)
+             '-p', 'wait_for_subscribers:=2', *sim_time,
+             *ros_args(remaps)], domain, log_dir)
         children.append(controller)
         wait_for(recorder, children, lambda: recorder.t0 is not None,
                  'the simulation start')
@@ -311,179 +330,20 @@ def tracking(scene, run):
     return float(np.sqrt(np.mean(run['err'] ** 2)))
 
 
-def torque_terms(scene, run):
-    """Split the torques of a recorded run into the scene's terms."""
-    from newton_euler_ros.core import (coriolis_matrix, gravity_torques,
-                                       jacobian, mass_matrix)
-    from newton_euler_ros.sim.simulate import SceneDynamics
-    dyn = SceneDynamics(scene)
-    model, eff = scene.model, scene.effects
-    t, q, qd = run['t'], run['q'], run['qd']
-    qdd = np.gradient(qd, t, axis=0) if len(t) > 2 else np.zeros_like(qd)
-    names = ['D qdd', 'C qd', 'g', 'J^T F', 'friction', 'armature']
-    terms = {k: np.zeros_like(q) for k in names}
-    for k in range(len(t)):
-        terms['D qdd'][k] = mass_matrix(model, q[k]) @ qdd[k]
-        if eff.velocity_products:
-            terms['C qd'][k] = coriolis_matrix(model, q[k], qd[k]) @ qd[k]
-        if eff.gravity:
-            terms['g'][k] = gravity_torques(model, q[k])
-        if eff.wrench:
-            w, frame = scene.wrench_at(t[k])
-            terms['J^T F'][k] = jacobian(model, q[k], frame).T @ w
-        if eff.friction:
-            terms['friction'][k] = dyn.friction(qd[k])
-        if eff.armature:
-            terms['armature'][k] = scene.armature * qdd[k]
-    return {k: v for k, v in terms.items()
-            if k == 'D qdd' or np.abs(v).max() > 0.0}
-
-
-def plots(scene, runs, terms, out):
-    """Write the PNG plots; return their file names."""
-    import matplotlib
-    matplotlib.use('Agg')
-    import matplotlib.pyplot as plt
-    joints = scene.model.joint_names
-    n = len(joints)
-    cols = 3
-    rows = (n + cols - 1) // cols
-    files = []
-
-    fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows),
-                             squeeze=False)
-    ff, pd = runs['feedforward'], runs['pd']
-    for j in range(n):
-        ax = axes[j // cols][j % cols]
-        ax.plot(ff['t'], ff['q_ref'][:, j], 'k--', lw=1.2, label='reference')
-        ax.plot(ff['t'], ff['q'][:, j], lw=1.2, label='PD + feedforward')
-        ax.plot(pd['t'], pd['q'][:, j], lw=1.2, label='PD alone')
-        ax.set_title(joints[j])
-        ax.set_xlabel('t [s]')
-        ax.set_ylabel('q [rad]')
-        ax.grid(alpha=0.3)
-    axes[0][0].legend(fontsize=8)
-    fig.suptitle(f'{scene.name}: joint tracking over ROS 2')
-    fig.tight_layout()
-    files.append('joint_tracking.png')
-    fig.savefig(os.path.join(out, files[-1]), dpi=100)
-    plt.close(fig)
-
-    fig, axes = plt.subplots(rows, cols, figsize=(13, 3.2 * rows),
-                             squeeze=False)
-    for j in range(n):
-        ax = axes[j // cols][j % cols]
-        for label, values in terms.items():
-            ax.plot(ff['t'], values[:, j], lw=1.0, label=label)
-        ax.plot(ff['t'], ff['tau'][:, j], 'k', lw=0.8, alpha=0.6,
-                label='commanded (PD + feedforward)')
-        ax.set_title(joints[j])
-        ax.set_xlabel('t [s]')
-        ax.set_ylabel('torque [N m]')
-        ax.grid(alpha=0.3)
-    axes[0][0].legend(fontsize=7)
-    fig.suptitle(f'{scene.name}: the terms of tau at the recorded states; '
-                 f"black: the torque the plant applied (the controller's "
-                 f'command, PD + feedforward)')
-    fig.tight_layout()
-    files.append('torque_terms.png')
-    fig.savefig(os.path.join(out, files[-1]), dpi=100)
-    plt.close(fig)
-
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4))
-    for key, label in (('feedforward', 'PD + feedforward'),
-                       ('pd', 'PD alone')):
-        run = runs[key]
-        axes[0].semilogy(run['t'], np.maximum(
-            np.linalg.norm(run['err'], axis=1), 1e-12), label=label)
-    axes[0].set_xlabel('t [s]')
-    axes[0].set_ylabel('|q - q_ref| [rad]')
-    axes[0].grid(alpha=0.3, which='both')
-    axes[0].legend()
-    width = 0.4
-    x = np.arange(n)
-    for off, key, label in ((-width / 2, 'feedforward', 'PD + feedforward'),
-                            (width / 2, 'pd', 'PD alone')):
-        rms = np.sqrt(np.mean(runs[key]['err'] ** 2, axis=0))
-        axes[1].bar(x + off, rms, width, label=label)
-    axes[1].set_yscale('log')
-    axes[1].set_xticks(x)
-    axes[1].set_xticklabels(joints)
-    axes[1].set_ylabel('RMS error [rad]')
-    axes[1].legend()
-    fig.suptitle(f'{scene.name}: tracking error with and without '
-                 f'feedforward')
-    fig.tight_layout()
-    files.append('tracking_error.png')
-    fig.savefig(os.path.join(out, files[-1]), dpi=100)
-    plt.close(fig)
-    return files
-
-
-def summary(scene, runs, rms, files, duration, wall):
-    """Return summary.md's text."""
-    ratio = rms['pd'] / rms['feedforward'] if rms['feedforward'] > 0 \
-        else float('inf')
-    lines = [
-        f'# Closed-loop demo: {scene.name}',
-        '',
-        f'{scene.description}',
-        '',
-        f'Robot {scene.model.name} ({scene.model.n} joints), '
-        f'{duration:g} s simulated at {scene.rate:g} Hz control over ROS 2 '
-        f'(robot_sim_node -> inverse_dynamics_node -> '
-        f'tracking_controller_node), integrator {scene.integrator} step '
-        f'{scene.step:g} s; wall time {wall:.1f} s.',
-        '',
-        '## Tracking',
-        '',
-        '| controller | RMS error [rad] | max error [rad] | joint states '
-        '| commands sent | received by the plant | recorded |',
-        '|---|---|---|---|---|---|---|',
-    ]
-    for key, label in (('feedforward', 'PD + feedforward'),
-                       ('pd', 'PD alone')):
-        run = runs[key]
-        lines.append(f'| {label} | {rms[key]:.3e} | '
-                     f'{np.abs(run["err"]).max():.3e} | {len(run["t"])} | '
-                     f'{run["sent"]} | {run["received"]} | '
-                     f'{run["commands"]} |')
-    lines += [
-        '',
-        'Commands: sent by tracking_controller_node (its count on exit), '
-        'received by robot_sim_node (its count on exit) and recorded by '
-        "this demo's probe, over the whole run: the controller answers "
-        'joint states from the start until it is stopped, first of the '
-        'nodes, so they may exceed the joint states recorded in '
-        '[0, duration].',
-        '',
-        f'RMS with feedforward: {rms["feedforward"]:.6e} rad',
-        f'RMS without feedforward: {rms["pd"]:.6e} rad',
-        f'Ratio (without / with): {ratio:.1f}',
-        '',
-        '## Effects',
-        '',
-        f'{", ".join(scene.effects.names()) or "none"}',
-        '',
-        '## Compute cost per effect',
-        '',
-        'Not timed here: a demo shares the CPU with five processes, and '
-        'timings taken beside them contradict each other. `make bench` '
-        '(`python -m newton_euler_tools.bench_effects`) times each effect '
-        'side by side on a quiet machine.',
-    ]
-    lines += ['', '## Plots', ''] + [f'![{f}]({f})' for f in files] + ['']
-    return '\n'.join(lines)
-
-
 def main(argv=None):
     """Run the closed-loop demo; return the exit status."""
     parser = argparse.ArgumentParser(
         prog='python -m newton_euler_tools.demo',
         description='Closed-loop ROS 2 demo: tracking with and without '
                     'Newton-Euler feedforward.')
-    parser.add_argument('--scene', default=SCENE,
-                        help=f'scene name or file (default {SCENE})')
+    parser.add_argument('--plant', choices=sorted(PLANTS), default=PLANT,
+                        help='the simulated robot: mujoco (mujoco_sim_node, '
+                             "MuJoCo's physics; default) or newton_euler "
+                             "(robot_sim_node, the library's own)")
+    parser.add_argument('--scene', default=None,
+                        help='scene name or file (default: '
+                             + ', '.join(f'{v[-1]} on {k}'
+                                         for k, v in PLANTS.items()) + ')')
     parser.add_argument('--duration', type=float, default=None,
                         help='seconds of simulated time (default: the '
                              "scene's duration)")
@@ -492,6 +352,7 @@ def main(argv=None):
     parser.add_argument('--quick', action='store_true',
                         help=f'{QUICK_DURATION:g} s runs, short benchmark')
     args = parser.parse_args(argv)
+    args.scene = args.scene or PLANTS[args.plant][-1]
     os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
 
     from newton_euler_ros.core import NewtonEulerError
@@ -523,8 +384,8 @@ def main(argv=None):
         for k, (key, feedforward) in enumerate((('feedforward', True),
                                                 ('pd', False))):
             domain = base + k
-            runs[key] = run_graph(scene_arg, key, feedforward, duration, domain,
-                                  log_dir)
+            runs[key] = run_graph(scene_arg, key, feedforward, duration,
+                                  domain, log_dir, args.plant)
             if len(runs[key]['t']) < 2:
                 raise DemoError(f'[{key}] too few joint states recorded')
             rms[key] = tracking(scene, runs[key])
@@ -534,9 +395,17 @@ def main(argv=None):
         print(f'demo: {exc}', file=sys.stderr)
         return 1
     wall = time.monotonic() - started
+    costs = None
+    if args.plant == 'mujoco':
+        from .mujoco_costs import measure
+        print('what accuracy costs: each effect left out of the '
+              'feedforward, on MuJoCo (offline)', flush=True)
+        costs = measure(scene, *((500, 3) if args.quick else (4000, 7)),
+                        duration)
     terms = torque_terms(scene, runs['feedforward'])
     files = plots(scene, runs, terms, out)
-    text = summary(scene, runs, rms, files, duration, wall)
+    text = summary(scene, runs, rms, files, duration, wall, args.plant,
+                   costs)
     with open(os.path.join(out, 'summary.md'), 'w') as fh:
         fh.write(text)
     np.savez(os.path.join(out, 'runs.npz'),

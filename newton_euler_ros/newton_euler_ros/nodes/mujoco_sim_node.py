@@ -27,6 +27,15 @@ stamped in simulated time, and ``/clock``, so the graph can run on
 ``use_sim_time``.  The ticks are paced by the wall clock at
 ``real_time_factor`` (0: as fast as the machine can).
 
+With ``scene`` (a scene file or bundled scene, docs/mujoco.md), the
+scene makes the plant (:func:`..sim.mujoco_scene.scene_plant`): its
+robot, initial state, physics step and integrator, its effects (gravity,
+payload, friction, rotor inertia, the wrench's reaction) and its
+``contacts`` (floor, table, pusher).  With ``wait_for_subscribers`` N,
+simulated time stays at 0 (no tick) until joint_states has N matched
+subscribers; the latched ``~/start`` then carries the stamp of t = 0 (a
+controller's reference starts there).
+
 Until the first valid command the arm holds its initial pose, brakes on,
 as a real arm does before its controller starts (time runs, nothing
 moves); the log says when the brakes are released.  A command of the
@@ -56,9 +65,12 @@ Publishes
     joint_states (sensor_msgs/JointState: position, velocity and effort =
     the torque the motors applied; mimic followers after the commanded
     joints, effort 0), /clock (rosgraph_msgs/Clock: simulated time, every
-    tick), ~/contact_wrenches/<link> (geometry_msgs/WrenchStamped, see
-    above), /diagnostics (diagnostic_msgs/DiagnosticArray, every second:
-    commands received, bad commands ignored, stale periods, the real-time
+    tick), ~/start (std_msgs/Header, transient local: the stamp of
+    t = 0), wrench (geometry_msgs/WrenchStamped: a scene's wrench,
+    every tick, as robot_sim_node publishes it),
+    ~/contact_wrenches/<link> (geometry_msgs/WrenchStamped, see above),
+    /diagnostics (diagnostic_msgs/DiagnosticArray, every second: commands
+    received, bad commands ignored, stale periods, the real-time
     factor achieved, whether the brakes hold)
 """
 import math
@@ -74,10 +86,11 @@ from rclpy.clock import Clock, ClockType
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 from sensor_msgs.msg import JointState
-from std_msgs.msg import Float64MultiArray, String
+from std_msgs.msg import Float64MultiArray, Header, String
 
 from .common import (ConfigurationError, declare_parameters, qos_profile,
                      QUIET, release_memory, run_node, SharedGraphNode)
+from .robot_sim_node import FRAME_IDS
 from ..core import NewtonEulerError
 from ..core.text import clip
 from ..parameters import load_specs
@@ -129,6 +142,24 @@ def load_plant(source, params, label=None):
         raise ConfigurationError(f'initial_positions: {exc}') from None
 
 
+def scene_plant_of(params):
+    """Return (MujocoPlant, scene) of the ``scene`` parameter."""
+    from ..sim.mujoco_scene import scene_plant
+    from ..sim.scene import load_scene
+    for key, default in (('robot_file', ''), ('joints', []),
+                         ('initial_positions', []), ('timestep', 0.001)):
+        if params[key] not in (default, [], ()):
+            raise ConfigurationError(
+                f'{key}: the scene gives it; leave it unset with scene')
+    try:
+        scene = load_scene(params['scene'])
+        plant = scene_plant(scene)
+    except (NewtonEulerError, ValueError, OSError) as exc:
+        raise ConfigurationError(f'scene: {clip(str(exc), 400)}') from None
+    plant.hold()
+    return plant, scene
+
+
 class MujocoSimNode(SharedGraphNode):
     """MuJoCo plant: efforts in, joint states, /clock and contacts out."""
 
@@ -136,13 +167,9 @@ class MujocoSimNode(SharedGraphNode):
         super().__init__(NAME, **kwargs)
         self.specs = load_specs(NAME)
         p = self.params = declare_parameters(self, self.specs)
-        if p['scene']:
-            # the hook for scene objects (table, pusher, payload): a scene
-            # file will add them to the model before it is compiled
-            raise ConfigurationError(
-                'scene: scene objects are not supported by mujoco_sim_node '
-                'yet; leave scene empty to simulate the robot alone')
         self.plant = None
+        self.subscribers = p['wait_for_subscribers']
+        self.started = False
         self.rtf = p['real_time_factor']
         self.timeout = p['command_timeout']
         self.wall = Clock(clock_type=ClockType.STEADY_TIME)
@@ -175,7 +202,21 @@ class MujocoSimNode(SharedGraphNode):
                                  self._on_command, qos)
         self.create_timer(DIAGNOSTICS_PERIOD, self._on_diagnostics,
                           clock=self.wall)
-        if p['robot_file']:
+        self.start_pub = self.create_publisher(Header, '~/start',
+                                               DESCRIPTION_QOS)
+        self.scene = self.wrench_pub = None
+        if p['scene']:
+            plant, self.scene = scene_plant_of(p)
+            wrench = self.scene.wrench
+            if self.scene.effects.wrench and wrench.kind != 'topic':
+                # the scene's wrench, as a force/torque sensor reads it:
+                # the inverse-dynamics node takes it from this topic
+                self.wrench_pub = self.create_publisher(
+                    WrenchStamped, 'wrench', qos, event_callbacks=QUIET)
+                self._scene_wrench = WrenchStamped()
+                self._scene_wrench.header.frame_id = FRAME_IDS[wrench.frame]
+            self._start(plant)
+        elif p['robot_file']:
             self._start(load_plant(p['robot_file'], p))
         else:
             self.create_subscription(String, 'robot_description',
@@ -197,8 +238,8 @@ class MujocoSimNode(SharedGraphNode):
         self._zero = np.zeros(robot.n)
         self._zero_followers = [0.0] * len(robot.followers)
         self.tau = self._zero.copy()
-        steps = max(1, int(round(1.0 / self.params['rate']
-                                 / m.opt.timestep)))
+        rate = self.scene.rate if self.scene else self.params['rate']
+        steps = max(1, int(round(1.0 / rate / m.opt.timestep)))
         self.period = steps * m.opt.timestep
         # the frame of the contact wrenches' axes: the world's, named by
         # the robot's root link when that has the world's axes (a URDF's
@@ -312,6 +353,16 @@ class MujocoSimNode(SharedGraphNode):
 
     def _tick(self):
         plant = self.plant
+        if not self.started:
+            if self.state_pub.get_subscription_count() < self.subscribers:
+                return      # t = 0 held until the graph is there
+            self.started = True
+            self.start_pub.publish(Header(stamp=stamp(plant.time),
+                                          frame_id='sim_start'))
+            self.get_logger().info(
+                f'simulation starts (t = {plant.time:g} s; joint_states '
+                f'has {self.state_pub.get_subscription_count()} '
+                f'subscribers)')
         if plant.held and self.commanded:
             plant.release()
             self.get_logger().info(
@@ -334,6 +385,13 @@ class MujocoSimNode(SharedGraphNode):
         now = stamp(plant.time)
         self._clock_msg.clock = now
         self.clock_pub.publish(self._clock_msg)
+        if self.wrench_pub is not None:     # first: the torques need it
+            w = self.scene.wrench.at(plant.time)
+            m = self._scene_wrench
+            m.header.stamp = now
+            f, n = m.wrench.force, m.wrench.torque
+            f.x, f.y, f.z, n.x, n.y, n.z = (float(x) for x in w)
+            self.wrench_pub.publish(m)
         q, qd = plant.state()
         effort = self._zero if plant.held else plant.applied()
         msg = self._state

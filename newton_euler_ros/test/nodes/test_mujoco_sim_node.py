@@ -245,7 +245,10 @@ def test_holds_then_falls_as_mujoco_does(tmp_path):
 
 
 def test_damping_friction_bad_and_stale_commands(tmp_path):
-    run = Session(tmp_path, 43, rate=500.0, command_timeout=0.5)
+    # at half real time: a test process slowed by a busy machine still
+    # commands within command_timeout of the plant's simulated time
+    run = Session(tmp_path, 43, rate=500.0, command_timeout=0.5,
+                  real_time_factor=0.5)
     latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
                          durability=DurabilityPolicy.TRANSIENT_LOCAL)
     description = run.probe.node.create_publisher(
