@@ -162,7 +162,7 @@ class Recorder:
     def _on_state(self, msg):
         stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
         self.states.append((stamp, list(msg.position), list(msg.velocity),
-                            list(msg.effort)))
+                            list(msg.effort), time.monotonic()))
 
     def _on_command(self, msg):
         self.commands.append((time.time(), list(msg.data)))
@@ -307,7 +307,12 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir,
     order = np.argsort(stamps[keep], kind='stable')
     rows = [r for r, k in zip(recorder.states, keep) if k]
     rows = [rows[i] for i in order]
+    arrived = np.array([r[4] for r in rows])
+    span = arrived.max() - arrived.min() if len(rows) > 1 else 0.0
     run = {
+        # simulated seconds per wall-clock second, as the states arrived
+        'real_time_factor': (float(np.ptp(stamps[keep]) / span)
+                             if span > 0 else float('nan')),
         't': stamps[keep][order],
         'q': np.array([r[1] for r in rows]),
         'qd': np.array([r[2] for r in rows]),
@@ -318,7 +323,8 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir,
     }
     print(f'[{label}] commands: {run["sent"]} sent by the controller, '
           f'{run["received"]} received by the plant, {run["commands"]} '
-          f'recorded', flush=True)
+          f'recorded; real-time factor {run["real_time_factor"]:.2f}',
+          flush=True)
     return run
 
 
