@@ -47,6 +47,7 @@ import sys
 
 from builtin_interfaces.msg import Duration
 import numpy as np
+from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration as Span
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -128,7 +129,11 @@ class TrackingControllerNode(SharedGraphNode):
             JointState, '~/feedforward', self._on_ff, self.qos)
             if self.use_ff else None)
         self.state_sub = None       # once the peers are matched
-        self.create_timer(REPUBLISH, self._on_timer)
+        # on the wall clock: with use_sim_time, ROS time stands still
+        # until the plant's /clock, which waits for this node's
+        # joint_states subscription, which this timer makes
+        self.create_timer(REPUBLISH, self._on_timer,
+                          clock=Clock(clock_type=ClockType.STEADY_TIME))
         self._cmd = Float64MultiArray()
         self.get_logger().info(
             f'{self.scene.name}: PD on {self.n} joints'

@@ -124,9 +124,11 @@ def test_graph_topics_are_the_nodes_defaults():
         assert default == name.replace('~', 'inverse_dynamics_node')
 
 
-@pytest.mark.parametrize('feedforward', [False, True])
+@pytest.mark.parametrize('feedforward, sim_time', [
+    (False, False), (True, False), (True, True)],
+    ids=['pd', 'feedforward', 'feedforward-sim-time'])
 def test_subscribes_to_joint_states_once_its_peers_are_matched(
-        tmp_path, feedforward):
+        tmp_path, feedforward, sim_time):
     """
     The handshake that lets a simulator start its clock in time.
 
@@ -134,6 +136,9 @@ def test_subscribes_to_joint_states_once_its_peers_are_matched(
     is one only once ~/commands has ``wait_for_subscribers`` matched
     subscribers (and, with feedforward, ~/feedforward and ~/reference are
     matched too), so the simulator never starts before it can be heard.
+    With ``use_sim_time`` (the MuJoCo plant's graph) ROS time stands
+    still until the plant's first /clock, which itself waits for this
+    subscription: the handshake must not wait on ROS time.
     """
     from sensor_msgs.msg import JointState
     from std_msgs.msg import Float64MultiArray
@@ -141,6 +146,7 @@ def test_subscribes_to_joint_states_once_its_peers_are_matched(
     domain = domain_id(91)
     node = NodeProcess(node_cmd('-p', f'feedforward:={str(feedforward)}',
                                 '-p', 'wait_for_subscribers:=2',
+                                '-p', f'use_sim_time:={str(sim_time)}',
                                 *ros_args(CONTROLLER_REMAPS)),
                        domain, str(tmp_path / 'node.log'))
     probe = Probe(domain)
