@@ -75,7 +75,7 @@ bench: setup
 	$(PY) -m newton_euler_tools.bench_regressor
 	$(PY) -m newton_euler_tools.bench_observer
 	$(PY) -m newton_euler_tools.bench_identify
-	$(PY) -m newton_euler_tools.bench_mujoco
+	$(PY) -m newton_euler_tools.bench_mujoco --loop
 
 # identification alone: 40 s recording time; 1 and 30 min time and peak
 # memory (about a minute and a half: writing and reading the 30 min bag
