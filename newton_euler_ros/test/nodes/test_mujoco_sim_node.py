@@ -415,6 +415,10 @@ def test_contact_wrench_of_a_bar_resting_on_the_floor(tmp_path):
      'robot_file: /no/such/robot.urdf: cannot read'),
     ({'robot_file': 'panda', 'initial_positions': [0.1, 0.2]},
      'initial_positions: 7 values expected'),
+    ({'scene': 'panda_mujoco_push', 'robot_file': 'panda'},
+     'robot_file: the scene gives it; leave it unset with scene'),
+    ({'scene': 'puma_payload_press'},
+     "scene: puma560.yaml: MuJoCo refuses link 'link1'"),
 ])
 def test_configuration_errors_are_one_line(tmp_path, params, message):
     proc = subprocess.run(node_cmd(tmp_path, **params),
@@ -426,3 +430,46 @@ def test_configuration_errors_are_one_line(tmp_path, params, message):
     assert lines == [f'mujoco_sim_node: invalid configuration: '
                      f'{lines[0].split(": ", 2)[-1]}'], proc.stderr
     assert message in lines[0], proc.stderr
+
+
+def test_a_scene_makes_the_plant_and_its_pusher_is_felt_on_the_topic(
+        tmp_path):
+    """
+    With ``scene``: the scene's robot, state and objects; t = 0 latched.
+
+    panda_mujoco_push: once released, the arm (zero effort) falls while
+    the pusher presses link 7 with 20 N along +y from t = 1.22 s to
+    1.9 s; ~/contact_wrenches/link7 carries MuJoCo's contact force, and
+    a link that leaves contact gets one zero wrench.
+    """
+    from geometry_msgs.msg import WrenchStamped
+    from std_msgs.msg import Header
+    run = Session(tmp_path, 45, scene='panda_mujoco_push',
+                  real_time_factor=2.0, wait_for_subscribers=1)
+    latched = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                         durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    start = []
+    run.probe.node.create_subscription(
+        Header, '/mujoco_sim_node/start', start.append, latched)
+    pushes = run.probe.collect(
+        WrenchStamped, '/mujoco_sim_node/contact_wrenches/link7', 1000)
+    try:
+        run.wait_up(2)
+        assert start and start[-1].stamp.sec == start[-1].stamp.nanosec == 0
+        np.testing.assert_array_equal(
+            run.states[0].position, [0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8])
+        run.pub.publish(command(np.zeros(7)))
+        run.wait_time(2.1, timeout=60.0)
+        run.probe.spin_for(0.2)
+        assert pushes, run.node.log()
+        t = np.array([t_of(m) for m in pushes])
+        fy = np.array([m.wrench.force.y for m in pushes])
+        assert 1.2 <= t[0] <= 1.25
+        held = (t > 1.4) & (t < 1.85)
+        assert held.any()
+        # the ball's inertia and the soft contact ride on the 20 N push
+        assert 15.0 < np.median(fy[held]) < 25.0
+        assert pushes[-1].wrench.force.y == 0.0     # left contact
+        assert pushes[-1].header.frame_id == 'base_link'
+    finally:
+        run.close()
