@@ -300,6 +300,22 @@ class SharedGraphNode(Node):
                 f'qos_overrides: {prefix[len(QOS_OVERRIDES):-1]}: {values}')
         return entity
 
+    def create_tick_timer(self, period, tick, **kwargs):
+        """
+        Create a timer calling ``tick``; an error after shutdown is quiet.
+
+        On SIGINT the context closes while a tick may still publish: that
+        publish fails, and is not an error of the node.  Any other
+        exception is raised.
+        """
+        def call():
+            try:
+                tick()
+            except Exception:
+                if self.context.ok():
+                    raise
+        return self.create_timer(period, call, **kwargs)
+
 
 def check_overrides(node, specs):
     """

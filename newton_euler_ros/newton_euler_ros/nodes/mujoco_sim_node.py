@@ -271,7 +271,7 @@ class MujocoSimNode(SharedGraphNode):
         self.plant = plant
         self._window = (time.monotonic(), plant.time)
         wall_period = 0.0 if self.rtf == 0.0 else self.period / self.rtf
-        self.create_timer(wall_period, self._on_tick, clock=self.wall)
+        self.create_tick_timer(wall_period, self._tick, clock=self.wall)
 
     def _contact_topics(self, plant):
         """Create one contact-wrench publisher per link of the robot."""
@@ -343,14 +343,6 @@ class MujocoSimNode(SharedGraphNode):
             self.commanded = True
 
     # ---- the tick ----
-    def _on_tick(self):
-        try:
-            self._tick()
-        except Exception:
-            if self.context.ok():
-                raise
-            # shutting down (SIGINT): a publish on the closed context fails
-
     def _tick(self):
         plant = self.plant
         if not self.started:

@@ -197,7 +197,7 @@ class RobotSimNode(SharedGraphNode):
         self._wrench = WrenchStamped()
         if scene.wrench is not None:
             self._wrench.header.frame_id = FRAME_IDS[scene.wrench.frame]
-        self.create_timer(self.period / rtf, self._on_tick)
+        self.create_tick_timer(self.period / rtf, self._tick)
         self.get_logger().info(
             f'{scene.name}: {scene.model.name}, {n} joints, effects '
             f'{scene.effects.names()}, {scene.integrator} step '
@@ -241,14 +241,6 @@ class RobotSimNode(SharedGraphNode):
         if self.ready_since is None:
             self.ready_since = now
         return now - self.ready_since >= GRACE
-
-    def _on_tick(self):
-        try:
-            self._tick()
-        except Exception:
-            if self.context.ok():
-                raise
-            # shutting down (SIGINT): a publish on the closed context fails
 
     def _tick(self):
         now = self.get_clock().now().nanoseconds
