@@ -59,7 +59,8 @@ from .common import (check_parameters, ConfigurationError,
                      declare_parameters, qos_profile, QUIET,
                      release_memory, run_node, seconds, SharedGraphNode)
 from .inverse_dynamics_reports import (answer, diagnostics, failed,
-                                       model_line, no_model_text)
+                                       mimic_line, model_line,
+                                       no_model_text)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
@@ -202,6 +203,9 @@ class InverseDynamicsNode(SharedGraphNode):
     def _log_model(self, ff, source):
         self.get_logger().info(model_line(ff, source, self.mode,
                                           self.payload, self.params))
+        mimic = mimic_line(ff)
+        if mimic is not None:
+            self.get_logger().info(mimic)
 
     # ---- robot_description ----
     def _on_description(self, msg):

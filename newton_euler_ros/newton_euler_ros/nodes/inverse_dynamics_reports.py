@@ -16,7 +16,8 @@
 What inverse_dynamics_node reports: its model, /diagnostics, the service.
 
 Message building only, off the hot path: the log line that says which
-model the node runs with (:func:`model_line`), the two statuses of its
+model the node runs with (:func:`model_line`, and :func:`mimic_line`
+listing a whole robot's mimic joints), the two statuses of its
 /diagnostics (:func:`diagnostics`: input counters, model), and the
 ``~/compute_dynamics`` response (:func:`answer` from the computer's
 terms, :func:`failed`).
@@ -41,10 +42,10 @@ def model_line(ff, source, mode, payload, params):
                else 'all rigid-body')
     whole = ''
     if ff.merger is not None:
-        mimic = [f'{f} follows {lead}' for f, (lead, _, _) in
-                 ff.merger.followers.items()]
+        count = len(ff.merger.followers)
         whole = (f'whole robot, {model.nb} moving joints'
-                 + (f' ({clip(", ".join(mimic), 300)})' if mimic else '')
+                 + (f' ({count} of them mimic, listed on the next line)'
+                    if count else '')
                  + f', commanding {ff.order.command} on torque_command;'
                  f' joints held {params["joint_states.hold"]} s; ')
     return (
@@ -63,6 +64,24 @@ def model_line(ff, source, mode, payload, params):
         + (', without g(q): the robot adds it '
            '(robot_compensates_gravity)'
            if ff.robot_compensates_gravity else ''))
+
+
+def mimic_line(ff):
+    """
+    Return the line listing every mimic joint under its leader, or None.
+
+    The start-up line gives their count; this line gives them all,
+    never cut (a hand or two grippers have tens of them).
+    """
+    if ff.merger is None or not ff.merger.followers:
+        return None
+    leads = {}
+    for follower, (lead, _, _) in ff.merger.followers.items():
+        leads.setdefault(lead, []).append(follower)
+    return (f'{ff.model.name}: {len(ff.merger.followers)} mimic joints, '
+            f'each following its leader: ' + '; '.join(
+                f'{lead} leads {", ".join(followers)}'
+                for lead, followers in leads.items()))
 
 
 def answer(response, ff, request, now):

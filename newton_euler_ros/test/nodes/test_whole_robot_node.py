@@ -44,6 +44,9 @@ only, no ``tip_link``, the left arm's joints (shuffled) on
   gripper: the external torque on every joint is J^T F, and of the
   wrenches of ``observer.end_effectors`` the left gripper's is F, the
   right one's zero.
+
+And PR2 from ``robot_file``: the start-up line counts its ten mimic
+joints, the next line lists them all under their leaders, none cut off.
 """
 import os
 import random
@@ -502,3 +505,42 @@ def test_the_simulated_tree_held_by_the_node(baxter, tmp_path):
     # the simulator ran on the node's commands (it holds t = 0 without)
     received = int(sim.log().split('commands received: ')[1].split()[0])
     assert received > 300, sim.log()
+
+
+def test_the_start_up_line_counts_the_mimic_joints_the_next_lists_all(
+        tmp_path):
+    """PR2: ten mimic joints, none of them cut off with '...'."""
+    import time
+    from newton_euler_tools.peers import example_robot_urdf
+    path = example_robot_urdf('pr2_description/urdf/pr2.urdf')
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_urdf(path, base='base_link')
+    followers = {name: model.moving_joints[model.mimic[b][0]]
+                 for b, name in enumerate(model.moving_joints)
+                 if model.mimic[b] is not None}
+    assert len(followers) == 10
+    node = NodeProcess(id_node_cmd(
+        None, '-p', f'robot_file:={path}', '-p', 'base_link:=base_link'),
+        domain_id(47), str(tmp_path / 'node.log'))
+    try:
+        deadline = time.monotonic() + 90.0
+        while 'mimic joints, each following' not in node.log():
+            assert node.alive() and time.monotonic() < deadline, node.log()
+            time.sleep(0.2)
+    finally:
+        assert node.stop() == 0, node.log()
+    lines = node.log().splitlines()
+    at = next(k for k, line in enumerate(lines) if 'whole robot' in line)
+    start, listed = lines[at], lines[at + 1]
+    assert (f'whole robot, {model.nb} moving joints (10 of them mimic, '
+            f'listed on the next line), commanding {model.n} on '
+            f'torque_command') in start, start
+    assert listed.endswith(f'{model.name}: 10 mimic joints, each following '
+                           'its leader: ' + '; '.join(
+                               f'{lead} leads ' + ', '.join(
+                                   f for f, x in followers.items()
+                                   if x == lead)
+                               for lead in dict.fromkeys(
+                                   followers.values()))), listed
+    assert '...' not in start + listed
