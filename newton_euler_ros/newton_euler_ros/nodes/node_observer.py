@@ -44,6 +44,7 @@ from ..core.effects import friction_torque
 from ..core.effort_units import EffortMonitor
 from ..core.text import clip
 from ..joint_inputs import InputRejected
+from ..safety import joint_units
 
 
 class NodeObserver:
@@ -304,8 +305,9 @@ class NodeObserver:
             self.contact_pub.publish(Bool(data=now))
             if now:
                 self.node.get_logger().info(
-                    f'observer: contact (number {self.contact.count}), '
-                    f'external torque {[round(x, 2) for x in r.tolist()]}')
+                    f'observer: contact (number {self.contact.count}): '
+                    + contact_text(self.obs, self.contact, r,
+                                   self.state.allowance))
 
     def publish_contact(self):
         """Publish ~/contact at the steady rate."""
@@ -350,6 +352,33 @@ class NodeObserver:
                 self.params['observer.rest_reference'], contact)),
             KeyValue(key='effort_units', value=_units_text(units))]
         return status
+
+
+def contact_text(obs, contact, r, allowance):
+    """
+    Name the joints in contact, each with its residual and threshold.
+
+    ``joint2 4.1 N m (threshold 2)``; ``+ 0.5 static friction`` where
+    the joint's static friction allowance raises the bound; a joint
+    found by the rest reference alone by its change from its rest value.
+    """
+    units = joint_units(obs.model)
+    rest = contact.rest
+    by_rest = (rest.active if rest is not None and obs.rest_reference
+               else np.zeros(obs.n, dtype=bool))
+    parts = []
+    for j, name in enumerate(obs.model.joint_names):
+        thr, unit = obs.thresholds[j], units[j]
+        if contact.active[j]:
+            extra = allowance[j] if allowance is not None else 0.0
+            parts.append(f'{name} {r[j]:.3g} {unit} (threshold {thr:.3g}'
+                         + (f' + {extra:.3g} static friction'
+                            if extra > 0 else '') + ')')
+        elif by_rest[j]:
+            parts.append(f'{name} {r[j]:.3g} {unit}, '
+                         f'{rest.deviation[j]:.3g} from its rest value '
+                         f'(threshold {thr:.3g})')
+    return ', '.join(parts)
 
 
 def _rest_text(enabled, contact):

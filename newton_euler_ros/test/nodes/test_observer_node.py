@@ -20,9 +20,11 @@ JointStates whose efforts hold the arm still at a pose, from the
 Euler-Lagrange oracle: first free, then while the environment pushes on
 the tool with a known wrench (the drives then apply g - J^T F_ext).  The
 three topics must answer every JointState with its stamp, the wrench
-must come out as the push, and ~/contact must turn true mid-run.
+must come out as the push, and ~/contact must turn true mid-run, the log
+naming the joints in contact with their residuals and thresholds.
 """
 import os
+import re
 import subprocess
 import warnings
 
@@ -169,6 +171,20 @@ def test_observer_topics_and_a_contact_mid_run(graph, puma):
     status, kv = observer_status(g)
     assert kv['in_contact'] == 'true' and kv['contacts'] == '1', kv
     assert kv['state'] == 'running'
+    # the contact's log line names the joints in contact, each with its
+    # residual and threshold: those the push loads beyond 3 N m, not the
+    # wrist's (J^T F is 10.1, -15.4, -4.8, 0, 0, 0 N m)
+    lines = [x for x in g['node'].log().splitlines()
+             if 'observer: contact (number 1)' in x]
+    assert len(lines) == 1, g['node'].log()
+    said = lines[0].split('observer: contact (number 1): ')[1]
+    named = re.findall(r'(joint\d) (-?[\d.]+) N m \(threshold 3\)', said)
+    assert named and ', '.join(
+        f'{j} {v} N m (threshold 3)' for j, v in named) == said, said
+    for joint, value in named:
+        expected = (J.T @ PUSH)[NAMES.index(joint)]
+        assert abs(float(value)) > 3.0 and \
+            np.sign(float(value)) == np.sign(expected), said
     # torques went on all along
     assert len(g['torques']) >= len(stamps) - 1
 
