@@ -30,7 +30,8 @@ followers move with their leaders (their JointState entries are not
 read).
 
 Every problem with an input (a bag that is missing, corrupt or truncated,
-lacks the topic, the effort or a chain joint, is too short or does not
+lacks the topic, the effort or a chain joint, has efforts that are all
+zero (``replay``: no effort to compare), is too short or does not
 excite the arm, has efforts that cannot be in the unit ``--effort`` says;
 a known-mass recording that does not excite the mass; an unusable URDF;
 an output that would overwrite the input) is one line on stderr naming
@@ -430,6 +431,9 @@ def cmd_replay(args):
     except (NewtonEulerError, ValueError) as exc:
         _fail(str(exc) if str(exc).startswith(str(args.bag))
               else f'{args.bag}: {exc}')
+    if not np.any(js.effort):
+        _fail(f'{args.bag}: no effort to compare: every effort on '
+              f'{args.topic} is zero')
     if prep is None:
         _fail(f'{args.bag}: too short: nothing is left after filtering')
     model_tau = predict(model, drives, prep.q, prep.qd, prep.qdd)
@@ -452,6 +456,7 @@ def cmd_replay(args):
     names = model.joint_names
     _write_replay_csv(args.csv, names, ns, meas, mod)
     moving = np.abs(speed) > MOVING
+    silent = [name for j, name in enumerate(names) if not meas[:, j].any()]
     if _describe(model):
         print(_describe(model))
     print(f'{args.bag}: {len(ns)} of {len(js)} messages (filter edges and '
@@ -473,10 +478,14 @@ def cmd_replay(args):
         f'sharply there, so on a joint with friction and little noise '
         f'it can exceed the raw one; docs/identification.md)', 78,
         initial_indent='  ', subsequent_indent='   '))
+    if silent:
+        print(f'note: every effort of {", ".join(silent)} is zero: '
+              f'nothing to compare there (-)', file=sys.stderr)
     print(f'wrote {args.csv}')
     if args.plot:
-        _plot(args.plot, (ns - ns[0]) * 1e-9, names, meas, mod, low,
-              'effort' if current else 'N m')
+        _plot(args.plot, replay_figure((ns - ns[0]) * 1e-9, names, meas,
+                                       mod, low, effort_units(model,
+                                                              drives)))
         print(f'wrote {args.plot}')
     return 0
 
@@ -506,12 +515,12 @@ def _rel(model, meas, mask=None):
     """
     RMS error relative to the RMS measurement, per column.
 
-    NaN for a column whose ``mask`` is false everywhere (no sample).
+    NaN for a column whose ``mask`` is false everywhere (no sample), or
+    whose measurement is zero there (no effort to compare).
     """
-    out = _rms(model - meas, mask) / np.maximum(_rms(meas, mask), 1e-300)
-    if mask is not None:
-        out = np.where(mask.any(axis=0), out, np.nan)
-    return out
+    rms = _rms(meas, mask)
+    return np.where(rms > 0, _rms(model - meas, mask)
+                    / np.where(rms > 0, rms, 1.0), np.nan)
 
 
 def _write_replay_csv(path, names, ns, meas, mod):
@@ -535,11 +544,33 @@ def _write_replay_csv(path, names, ns, meas, mod):
         _fail(f'{path}: cannot write: {exc.strerror or exc}')
 
 
-def _plot(path, t, names, meas, mod, low, unit):
+def effort_units(model, drives):
+    """
+    Return each joint's effort axis label with its unit, model order.
+
+    ``torque (N m)`` (``force (N)`` on a prismatic joint); where the URDF
+    gives torque constants the efforts are compared in their own unit
+    (a motor current: A on UR's driver), one of which is K N m.
+    """
+    from .safety import joint_units
+    units = joint_units(model)
+    if drives is None or drives.torque_constant is None:
+        return [('force (N)' if unit == 'N' else 'torque (N m)')
+                for unit in units]
+    return [f'effort (unit = {k:.4g} {unit})'
+            for k, unit in zip(drives.torque_constant, units)]
+
+
+def replay_figure(t, names, meas, mod, low, labels):
+    """
+    Draw measured against model per joint; return the figure.
+
+    ``t`` (s) since the first message; ``labels``: each joint's effort
+    axis label with its unit (:func:`effort_units`).
+    """
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
-    from .ident.urdf_out import atomic_open
     n = len(names)
     fig, axes = plt.subplots(n, 1, sharex=True, figsize=(10, 1.8 * n + 1),
                              squeeze=False)
@@ -547,11 +578,17 @@ def _plot(path, t, names, meas, mod, low, unit):
         ax.plot(t, meas[:, j], color='0.7', lw=0.6, label='measured')
         ax.plot(t, low[:, j], color='k', lw=0.9, label='measured, low-pass')
         ax.plot(t, mod[:, j], color='tab:red', lw=0.9, label='model')
-        ax.set_ylabel(f'{names[j]}\n{unit}', fontsize=8)
+        ax.set_ylabel(f'{names[j]}\n{labels[j]}', fontsize=8)
         ax.tick_params(labelsize=7)
     axes[0, 0].legend(loc='upper right', fontsize=7, ncol=3)
-    axes[-1, 0].set_xlabel('time (s)')
+    axes[-1, 0].set_xlabel('time since the first message (s)')
     fig.tight_layout()
+    return fig
+
+
+def _plot(path, fig):
+    import matplotlib.pyplot as plt
+    from .ident.urdf_out import atomic_open
     try:
         with atomic_open(path, 'wb') as f:
             fig.savefig(f, format='png', dpi=90)

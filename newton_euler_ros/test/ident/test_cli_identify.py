@@ -19,7 +19,9 @@ import subprocess
 import sys
 import warnings
 
-from newton_euler_ros.core import inverse_dynamics_batch, load_robot
+from newton_euler_ros.core import (inverse_dynamics_batch, load_robot,
+                                   load_urdf)
+from newton_euler_ros.core.drives import DRIVES_NS
 from newton_euler_ros.ident.bag import read_joint_states
 from newton_euler_ros.ident.bag_write import write_joint_states
 from newton_euler_tools.ident_example import (BASE, make_example,
@@ -117,6 +119,78 @@ def test_identify_and_replay(example, tmp_path):
         meas ** 2, axis=0))
     assert rel.mean() < 0.1
     assert 'rel % raw' in stdout
+
+
+def test_replay_of_a_recording_without_efforts_says_so(panda, tmp_path):
+    """All-zero efforts: one line, exit 2; one silent joint: '-'."""
+    bag = small_bag(tmp_path / 'moving', panda)
+    js = read_joint_states(bag, panda.joint_names)
+    names = list(panda.joint_names)
+    zero = np.zeros_like(js.effort)
+    write_joint_states(tmp_path / 'zero', js.stamps_ns, names, js.q, js.qd,
+                       zero)
+    csv_path, png = tmp_path / 'zero.csv', tmp_path / 'zero.png'
+    code, stdout, err = run('replay', panda_path(), tmp_path / 'zero',
+                            *CHAIN, '--csv', csv_path, '--plot', png)
+    assert code == 2, (stdout, err)
+    line = one_line_error(err, tmp_path / 'zero')
+    assert line.endswith('no effort to compare: every effort on '
+                         '/joint_states is zero'), line
+    assert stdout == '' and not csv_path.exists() and not png.exists()
+    # one joint whose driver reports no effort: no number for it, said
+    zero[:, :6] = js.effort[:, :6]
+    write_joint_states(tmp_path / 'one', js.stamps_ns, names, js.q, js.qd,
+                       zero)
+    code, stdout, err = run('replay', panda_path(), tmp_path / 'one',
+                            *CHAIN, '--csv', csv_path)
+    assert code == 0, err
+    row = next(x for x in stdout.splitlines()
+               if x.split()[:1] == ['panda_joint7'])
+    assert row.split()[2:] == ['-', '-', '-'], row
+    table = [x.split() for x in stdout.splitlines()
+             if x.split()[:1] and x.split()[0] in names + ['mean']]
+    assert len(table) == 8 and max(len(cell) for row in table
+                                   for cell in row) < 20, stdout
+    assert 'note: every effort of panda_joint7 is zero: nothing to ' \
+           'compare there (-)' in err, err
+
+
+def test_replay_plot_axes_carry_units(panda):
+    """Time in s; N m, N on a prismatic joint, the effort unit with K."""
+    from newton_euler_ros.cli_identify import effort_units, replay_figure
+    from newton_euler_ros.core.drives import model_drives
+    assert effort_units(panda, model_drives(panda)) == ['torque (N m)'] * 7
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        finger = load_robot(panda_path(), base=BASE, tip='panda_leftfinger')
+    assert effort_units(finger, model_drives(finger)) == \
+        ['torque (N m)'] * 7 + ['force (N)']
+    # a URDF whose drives give torque constants: efforts in their unit
+    with open(panda_path(), encoding='utf-8') as f:
+        text = f.read().replace(
+            'xmlns:xacro=', f'xmlns:ne="{DRIVES_NS}" xmlns:xacro=', 1)
+    for k in range(1, 8):
+        head = f'<joint name="panda_joint{k}" type="revolute">'
+        text = text.replace(head, head + f'<ne:drive torque_constant='
+                                         f'"{9 + k / 4}"/>', 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        current = load_urdf(text, base=BASE, tip=TIP)
+    labels = effort_units(current, model_drives(current))
+    assert labels == [f'effort (unit = {9 + k / 4:.4g} N m)'
+                      for k in range(1, 8)], labels
+    t = np.linspace(0.0, 1.0, 5)
+    y = np.zeros((5, 7))
+    fig = replay_figure(t, current.joint_names, y, y, y, labels)
+    try:
+        axes = fig.get_axes()
+        assert [ax.get_ylabel() for ax in axes] == [
+            f'{name}\n{label}'
+            for name, label in zip(current.joint_names, labels)]
+        assert axes[-1].get_xlabel() == 'time since the first message (s)'
+    finally:
+        import matplotlib.pyplot as plt
+        plt.close(fig)
 
 
 def test_refuses_to_overwrite_the_input(example, tmp_path):
