@@ -140,6 +140,40 @@ def vector(name, x, size):
     return arr
 
 
+SEQUENCES = (list, tuple)
+
+
+def inputs(ws, names, q, qd=None, third=None, wrench=None):
+    """
+    Return the four inputs of an entry as float64 vectors, each checked.
+
+    ``None`` is the workspace's zeros.  A list or tuple of the right
+    length (a state as Python lists, the common case) is copied into a
+    preallocated row of ``ws``, so no array is made; anything else goes
+    through :func:`vector`, which converts it or names what is wrong
+    (``names``: the inputs' names, ``INPUTS`` or ``FD_INPUTS``).  The rows
+    are overwritten by the next call on ``ws``: use them at once.
+    """
+    n = ws.n
+    given = (q, qd, third, wrench)
+    out = [ws.zeros, ws.zeros, ws.zeros, ws.zero_wrench]
+    for i in range(4):
+        x = given[i]
+        if x is None:
+            continue
+        size = 6 if i == 3 else n
+        if type(x) in SEQUENCES and len(x) == size:
+            row = ws.given_wrench if i == 3 else ws.given_rows[i]
+            try:
+                row[:] = x
+                out[i] = row
+                continue
+            except (TypeError, ValueError):
+                pass            # vector() says what is wrong
+        out[i] = vector(names[i], x, size)
+    return out
+
+
 def out_array(out, shape, dtype=np.float64):
     """Return a new array of ``shape``, or ``out`` once checked."""
     if out is None:

@@ -76,7 +76,8 @@ from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
                     gravity_torques_batch, inverse_dynamics_batch,
                     mass_matrix_batch)
 from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
-                      first_singular_pivot, foreign_workspace, FORWARD_DYNAMICS_METHODS, INT,
+                      first_singular_pivot, foreign_workspace,
+                      FORWARD_DYNAMICS_METHODS, INPUTS, inputs, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
                       out_array, PACKED, Refused, status_error, strict_entry,
                       VEC, vector, workspace, wrench_mode)
@@ -165,6 +166,10 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
             return _tau_at_links(model, ws, q, qd, qdd, wrench, wrench_frame,
                                  flags, out)
         flags |= wrench_mode(wrench, wrench_frame) << 2
+    if type(q) is not np.ndarray or (wrench is not None
+                                     and type(wrench) is not np.ndarray):
+        # lists: converted at once, rather than refused first
+        return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
     try:
         tau = np.empty(w.n) if out is None else out
         if _tau(model.packed, q, w.zeros if qd is None else qd,
@@ -184,10 +189,7 @@ def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
     """Call the Newton-Euler entry again, its arguments converted once."""
     ws = workspace(model, ws)
     n = ws.n
-    q = vector('q', q, n)
-    qd = ws.zeros if qd is None else vector('qd', qd, n)
-    qdd = ws.zeros if qdd is None else vector('qdd', qdd, n)
-    wrench = ws.zero_wrench if wrench is None else vector('wrench', wrench, 6)
+    q, qd, qdd, wrench = inputs(ws, INPUTS, q, qd, qdd, wrench)
     tau = out_array(out, (n,))
     code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
     if code >= 0:
@@ -215,6 +217,8 @@ def _tau_at_links(model, ws, q, qd, qdd, wrenches, wrench_frame, flags,
 def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
     w = model.default_workspace if ws is None else ws
+    if type(q) is not np.ndarray:   # a list: converted, not refused first
+        return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
     try:
         tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
@@ -354,6 +358,11 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
         method = 'cholesky'
     if method == 'aba':
         w = model.default_workspace if ws is None else ws
+        if type(q) is not np.ndarray or (wrench is not None
+                                         and type(wrench) is not np.ndarray):
+            # lists: converted at once, rather than refused first
+            return _aba_converted(model, ws, q, qd, tau, wrench,
+                                  wrench_frame, flags, out)
         try:
             qdd = np.empty(w.n) if out is None else out
             if _aba(model.packed, q, qd, tau,
@@ -387,8 +396,10 @@ def _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame, flags, out):
     """Call the articulated-body entry again, arguments converted once."""
     ws = workspace(model, ws)
     n = ws.n
-    q, qd, tau = vector('q', q, n), vector('qd', qd, n), vector('tau', tau, n)
-    w = ws.zero_wrench if wrench is None else vector('wrench', wrench, 6)
+    for name, x in (('q', q), ('qd', qd), ('tau', tau)):
+        if x is None:
+            vector(name, x, n)      # raises: each is required
+    q, qd, tau, w = inputs(ws, FD_INPUTS, q, qd, tau, wrench)
     qdd = out_array(out, (n,))
     code = _aba(model.packed, q, qd, tau, w, flags, ws.ws, ws.aw, qdd)
     if code == K.MIMIC:     # coupled joints: the Cholesky path

@@ -49,6 +49,10 @@ class Workspace:
         self.zeros = np.zeros(n, dtype)
         self.zero_wrench = np.zeros(6, dtype)
         self.status = np.zeros(1, np.int64)
+        # inputs given as lists or tuples, copied in (calling.sequences_in)
+        self.given = np.zeros((3, n), dtype)
+        self.given_rows = tuple(self.given)
+        self.given_wrench = np.zeros(6, dtype)
 
     def __repr__(self):
         """Return e.g. ``Workspace(n=6, float64)``."""

@@ -183,3 +183,54 @@ def test_a_ws_that_is_no_workspace_is_one_clear_error(arm, call):
     with pytest.raises(DynamicsInputError, match='ws must be a float64 '
                                                  'Workspace'):
         call(arm, np.zeros((2, 21)))
+
+
+def test_lists_copied_into_the_workspace_never_alias_a_result():
+    """
+    Lists are copied into rows of the workspace (calling.inputs).
+
+    The next call overwrites those rows: a result handed back, or the
+    Cholesky path a model with mimic joints takes from lists, must not
+    read them afterwards.
+    """
+    from random_tree import random_tree_urdf
+    arm = load_robot('puma560')
+    rng = np.random.default_rng(5)
+    a, b = rng.uniform(-1, 1, (2, 4, 6))
+    w = rng.uniform(-5, 5, (2, 6))
+    first = inverse_dynamics(arm, *a[:3].tolist(), w[0].tolist())
+    second = forward_dynamics(arm, *b[:3].tolist(), w[1].tolist())
+    assert np.array_equal(first, inverse_dynamics(arm, *a[:3], w[0]))
+    assert np.array_equal(second, forward_dynamics(arm, *b[:3], w[1]))
+    # a float64 q with a list wrench: the wrench converted, q as given
+    assert np.array_equal(inverse_dynamics(arm, a[0], wrench=list(w[0])),
+                          inverse_dynamics(arm, a[0], wrench=w[0]))
+    # mimic joints: the articulated-body entry refuses, the Cholesky path
+    # runs from the converted rows
+    import warnings
+    from newton_euler_ros.core import load_urdf
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        tree = load_urdf(random_tree_urdf(22, links=10)[0])
+    assert tree.nb > tree.n
+    q, qd, tau = rng.uniform(-1, 1, (3, tree.n))
+    assert np.array_equal(
+        forward_dynamics(tree, q.tolist(), qd.tolist(), tau.tolist()),
+        forward_dynamics(tree, q, qd, tau))
+
+
+@pytest.mark.parametrize('call, message', [
+    (lambda m: forward_dynamics(m, [0, 0], None, [0, 0]),
+     'qd must be a vector'),
+    (lambda m: forward_dynamics(m, [0, 0], [0, 0], None),
+     'tau must be a vector'),
+    (lambda m: forward_dynamics(m, [0, 0], [0, 0], [0, 0], [0] * 5),
+     'wrench must have 6 entries, got 5'),
+    (lambda m: inverse_dynamics(m, np.zeros(2), wrench=(0, 0, 'x', 0, 0, 0)),
+     'wrench must be a sequence'),
+    (lambda m: inverse_dynamics(m, (0, 0), (0, [1, 2])),
+     'qd must be a sequence'),
+])
+def test_bad_lists_name_the_argument(arm, call, message):
+    with pytest.raises(DynamicsInputError, match=message):
+        call(arm)
