@@ -218,7 +218,13 @@ def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
     w = model.default_workspace if ws is None else ws
     if type(q) is not np.ndarray:   # a list: converted, not refused first
-        return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
+        ws = workspace(model, ws)
+        q = inputs(ws, INPUTS, q)[0]
+        tau = out_array(out, (ws.n,))
+        code = _gravity(model.packed, q, ws.ws, tau)
+        if code >= 0:
+            raise status_error(code, (q,))
+        return tau
     try:
         tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
