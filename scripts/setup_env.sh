@@ -317,4 +317,11 @@ if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok tools "$H_TOOLS"; then
   stamp_write tools "$H_TOOLS"
 fi
 
+# ---------------------------------------------------------------------------
+# The kernels compiled into numba's cache once, ahead of any node's first
+# start (a minute or more on 2 cores); a stamp named by the compiled
+# sources' digest makes this a no-op (0.2 s) until they change.
+"$VENV/bin/python" -m newton_euler_ros.precompile \
+  || die "compiling the kernels ahead (python -m newton_euler_ros.precompile) failed"
+
 log "done: $("$VENV/bin/python" -c 'import sys; print(sys.executable)'), $(du -sh "$VENV" | cut -f1)"

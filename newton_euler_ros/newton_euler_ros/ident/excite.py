@@ -217,6 +217,11 @@ def _usable(limits, start):
             (1.0 - MARGIN) * limits.acceleration)
 
 
+def precompile():
+    """Compile (or load) this module's kernel (``precompile.py``)."""
+    _gram_eigenvalues(np.eye(2), np.ones(2))
+
+
 @njit(cache=True)
 def _gram_eigenvalues(A, scale):
     # single-threaded on purpose: a multi-threaded BLAS call on a small

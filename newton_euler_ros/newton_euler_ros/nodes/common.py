@@ -413,6 +413,51 @@ def release_memory():
 EXECUTORS = ('single_threaded', 'events')
 
 
+class KernelTimer:
+    """
+    Say, once per node, what loading the compiled kernels costs.
+
+    Before the first model is built: a warning when the kernels were not
+    compiled ahead for these sources (``python -m
+    newton_euler_ros.precompile``, which ``make setup`` runs), since the
+    node is then silent for a minute or more while numba compiles them.
+    After: how long it took.  ``start()`` and ``done(logger)`` bracket
+    the first build; later builds say nothing.
+    """
+
+    def __init__(self, logger):
+        self.logger = logger
+        self.started = None
+        self.said = False
+
+    def start(self):
+        """Call before the first build: warns if a compile is coming."""
+        import time
+        if self.said or self.started is not None:
+            return
+        from ..precompile import stamp_path
+        self.precompiled = os.path.exists(stamp_path())
+        if not self.precompiled:
+            self.logger.warning(
+                'the kernels were not compiled ahead for this install: '
+                'compiling what this node needs now (a minute or more on '
+                'a 2-core machine; nothing is published meanwhile). '
+                '"python -m newton_euler_ros.precompile" does it once, '
+                'ahead of time (make setup runs it)')
+        self.started = time.monotonic()
+
+    def done(self):
+        """Call after the first build: the time it took, said once."""
+        import time
+        if self.said or self.started is None:
+            return
+        self.said = True
+        took = time.monotonic() - self.started
+        how = ('loaded from the cache' if self.precompiled
+               else 'compiled, or loaded where the cache had them')
+        self.logger.info(f'kernels ready in {took:.1f} s ({how})')
+
+
 def make_executor(kind=None, context=None):
     """
     Return the executor ``kind`` names, for ``context`` (None: default).

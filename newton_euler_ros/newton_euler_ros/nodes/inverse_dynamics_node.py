@@ -56,7 +56,7 @@ from std_msgs.msg import Float64MultiArray, String
 from trajectory_msgs.msg import JointTrajectory
 
 from .common import (check_parameters, ConfigurationError,
-                     declare_parameters, qos_profile, QUIET,
+                     declare_parameters, KernelTimer, qos_profile, QUIET,
                      release_memory, run_node, seconds, SharedGraphNode)
 from .inverse_dynamics_reports import (answer, diagnostics, failed,
                                        mimic_line, model_line,
@@ -100,6 +100,7 @@ class InverseDynamicsNode(SharedGraphNode):
         # the joints over their torque bound, said once per change
         self._over_log = collections.defaultdict(OverLimitLog)
         self.ff = None          # swapped whole when a new model arrives
+        self.kernels = KernelTimer(self.get_logger())
         self.model_source = ''
         #: why the last robot_description was rejected ('' when it loaded)
         self.description_rejected = ''
@@ -136,6 +137,7 @@ class InverseDynamicsNode(SharedGraphNode):
                        else self.get_logger().warning)
                 log(f'robot file: {message}')
             try:
+                self.kernels.start()
                 self.ff = self._make_computer(model, scene)
             except ValueError as exc:
                 raise ConfigurationError(str(exc)) from None
@@ -189,6 +191,8 @@ class InverseDynamicsNode(SharedGraphNode):
         self._observer = None
         if self.params['observer.enabled']:
             self._observer = NodeObserver(self, self.params, self.ff)
+        if self.ff is not None:
+            self.kernels.done()
 
     def _make_computer(self, model, scene=None, previous=None,
                        payload=None):
@@ -221,7 +225,12 @@ class InverseDynamicsNode(SharedGraphNode):
             model, found, report = urdf_model(
                 text, 'robot_description', base=p['base_link'] or None,
                 tip=p['tip_link'] or None)
+            self.kernels.start()
             ff = self._make_computer(model)
+            if self._observer is not None:
+                # off the executor: a first message must not wait for
+                # the observer's kernels (joint states would queue up)
+                self._observer.warm_kernels(ff)
         except Exception as exc:  # never let a description kill the node
             reason = clip(str(exc), 400)
             if not isinstance(exc, (NewtonEulerError, ValueError)):
@@ -244,6 +253,7 @@ class InverseDynamicsNode(SharedGraphNode):
                        else self.get_logger().warning)
                 log(clip(message, 400))
             self.ff = ff        # one reference swap: callbacks see either
+            self.kernels.done()
             self.counts['descriptions_loaded'] += 1
             self.model_source = (
                 f'robot_description, {report["base"]} -> {report["tip"]}'

@@ -86,6 +86,16 @@ class NodeObserver:
             except ValueError as exc:
                 raise ConfigurationError(str(exc)) from None
 
+    def warm_kernels(self, ff):
+        """
+        Load (or compile) the observer's kernels for ``ff``'s model.
+
+        Called where a model is built off the executor (a new
+        robot_description), so that the first sample does not wait for
+        them; the observer itself is built on that sample.
+        """
+        momentum.MomentumObserver(ff.model).warm_up()
+
     def observer_for(self, ff):
         """
         Return the observer of this computer's model (payload included).

@@ -75,3 +75,22 @@ def test_a_copy_of_the_package_elsewhere_loads_what_the_first_compiled(
          'print(newton_euler_ros.__file__)'], env=env, cwd=str(tmp_path),
         capture_output=True, text=True, timeout=120)
     assert probe.stdout.strip().startswith(str(copy)), probe.stdout
+
+
+def test_make_setup_compiled_the_kernels_ahead():
+    """
+    ``make setup`` ran ``python -m newton_euler_ros.precompile``.
+
+    Its stamp for these sources is in the cache the tests use, and a
+    second run returns at once, without importing numba.
+    """
+    from newton_euler_ros import precompile
+    assert os.path.exists(precompile.stamp_path()), (
+        'no precompile stamp: make setup did not compile the kernels ahead')
+    code = ('import sys; from newton_euler_ros import precompile; '
+            'assert precompile.main([]) == 0; '
+            'assert "numba" not in sys.modules, "numba imported"')
+    proc = subprocess.run([sys.executable, '-c', code], capture_output=True,
+                          text=True, timeout=60)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout == '', proc.stdout

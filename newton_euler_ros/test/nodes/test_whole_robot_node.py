@@ -530,6 +530,10 @@ def test_the_start_up_line_counts_the_mimic_joints_the_next_lists_all(
             time.sleep(0.2)
     finally:
         assert node.stop() == 0, node.log()
+    # make setup compiled the kernels ahead: loaded, and said how long
+    assert 'kernels ready in' in node.log(), node.log()
+    assert '(loaded from the cache)' in node.log(), node.log()
+    assert 'not compiled ahead' not in node.log(), node.log()
     lines = node.log().splitlines()
     at = next(k for k, line in enumerate(lines) if 'whole robot' in line)
     start, listed = lines[at], lines[at + 1]
