@@ -44,36 +44,48 @@ the payload's pseudo-inertia positive semi-definite (so m >= 0 and the
 inertia physical), with a tiny pull toward zero so that directions the
 motion does not excite come out at zero instead of at noise.
 
-How well the recording determines each quantity: the covariance
-sigma^2 (A^T A)^-1 of the weighted problem, propagated to the mass, the
-centre of mass and the inertia about it.  A quantity is *undetermined*
-when its standard error exceeds ``MASS_TOL`` (relative) / ``COM_TOL`` (m) /
-``INERTIA_TOL`` (relative to the largest inertia term, or
-``INERTIA_ABS``), the uncertainty being what a change of the parameters
-as large as the torque residual could hide — a motion that never rotates the wrist cannot tell the
-inertia, and a payload that is not there has no centre of mass.
+How well the recording determines each quantity: one standard uncertainty
+u of the mass, each centre-of-mass coordinate and each inertia term about
+the com, propagated from the covariance of the ten parameters (delta
+method). That covariance is the largest of the estimates
+(:func:`_covariance`): the weighted residual's variance through (A^T W
+A)^-1, times the rows per independent sample of the filtered signals, and
+sandwiches over blocks of 5, 20 and 80 cutoff periods (0.5, 2 and 8 s at
+10 Hz) that hold when the residual is correlated for longer (the arm
+model's error follows the motion). All shrink as the recording grows. A
+quantity is *undetermined* when ``K_EXPAND`` u (about 95 % coverage)
+exceeds ``MASS_TOL`` of the mass (at least ``MASS_TOL_ABS``), ``COM_TOL``
+for a com coordinate, or ``INERTIA_TOL`` of the largest inertia term (at
+least ``INERTIA_ABS``); a direction the motion does not excite has no
+bound. A motion that never rotates the wrist cannot tell the inertia, and
+a payload whose mass does not stand ``PRESENT_SIGMAS`` u out of zero has
+no centre of mass.
 """
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from .reduce import IdentificationError, reduce_recording
+from .reduce import (FIT_RATE_FACTOR, IdentificationError,
+                     reduce_recording)
 from ..core.drives import model_drives
 from ..core.errors import NewtonEulerError
 from ..core.regressor import (link_inertials, N_INERTIAL, pseudo_inertia,
                               regressor_batch)
 from ..core.text import clip
 
-MASS_TOL = 0.05           # relative standard error of the mass
+# A value is determined when its expanded uncertainty (K_EXPAND standard
+# uncertainties, about 95 % coverage) is within these:
+K_EXPAND = 2.0
+MASS_TOL = 0.05           # relative
+MASS_TOL_ABS = 0.05       # kg: a mass known this well is determined
 MASS_ABS = 0.02           # kg: below this the payload is "no payload"
-MASS_TOL_ABS = 0.05       # kg: a mass error this small is determined
-# m, bound of each coordinate: the 15 mm a payload's centre of mass is
-# asked for (the bound is a worst case: a 2 kg tool's z came out 1 mm
-# off on a 4 s recording, with a bound of 14 mm)
-COM_TOL = 0.015
-INERTIA_TOL = 0.3         # relative standard error
+PRESENT_SIGMAS = 3.0      # a payload's mass stands out of its uncertainty
+COM_TOL = 0.015           # m, the 15 mm a payload's centre of mass is asked
+INERTIA_TOL = 0.3         # relative to the largest inertia term
 INERTIA_ABS = 2e-3        # kg m^2
+UNBOUNDED = 1e6           # an uncertainty this large is no bound
 PRIOR_WEIGHT = 1e-6       # pull toward zero, of the data's scale
+BLOCK_ROWS = int(5 * FIT_RATE_FACTOR)   # rows: five cutoff periods
 INERTIA_KEYS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 INERTIA_NAMES = ('Ixx', 'Iyy', 'Izz', 'Ixy', 'Iyz', 'Ixz')
 
@@ -188,14 +200,45 @@ class PayloadEstimate:
     residual_after: np.ndarray = None    # with the payload
     joint_names: list = field(default_factory=list)
 
+    def _uncertain(self):
+        """(quantity, its index, value, standard uncertainty, unit) rows."""
+        I = self.inertia  # noqa: E741
+        out = [('payload.mass', None, self.mass, self.mass_std)]
+        out += [('payload.com', a, self.com[a], self.com_std[a])
+                for a in range(3)]
+        out += [('payload.inertia', k, I[a, b], self.inertia_std[k])
+                for k, (a, b) in enumerate(INERTIA_KEYS)]
+        return out
+
+    def uncertainty(self):
+        """
+        One standard uncertainty of each value, as in :meth:`parameters`.
+
+        ``None`` where the motion leaves it unbounded (a direction it does
+        not excite at all).
+        """
+        out = {'payload.mass': None, 'payload.com': [None] * 3,
+               'payload.inertia': [None] * 6}
+        for key, k, _, u in self._uncertain():
+            u = float(u) if np.isfinite(u) and u < UNBOUNDED else None
+            if k is None:
+                out[key] = u
+            else:
+                out[key][k] = u
+        return out
+
     def parameters(self):
         """
         Return the node's payload.* parameters as a JSON-ready dict.
 
         What the motion does not determine is ``None`` (JSON ``null``):
         the mass, a centre-of-mass coordinate or an inertia term, and
-        ``'undetermined'`` maps each parameter holding one to the reason.
-        A parameter without ``None`` can be set on the node as it is.
+        ``'undetermined'`` maps each parameter holding one to the reason,
+        with the estimate and its uncertainty.  A parameter without
+        ``None`` can be set on the node as it is.  ``'uncertainty'``:
+        one standard uncertainty of every value (kg, m, kg m^2), null
+        where unbounded; a value is determined when ``K_EXPAND`` times it
+        is within its tolerance (``MASS_TOL``, ``COM_TOL``, ``INERTIA_TOL``).
         """
         d = self.determined
         I = self.inertia  # noqa: E741
@@ -206,23 +249,33 @@ class PayloadEstimate:
                'payload.com': com, 'payload.inertia': inertia}
         why = {}
         if not d['mass']:
-            why['payload.mass'] = (f'standard error {self.mass_std:.3g} kg')
+            why['payload.mass'] = (f'estimate {self.mass:.4g} kg, standard '
+                                   f'uncertainty {_u(self.mass_std)} kg')
         if not d['present']:
-            reason = (f'no payload: the mass is below {MASS_ABS:g} kg or '
-                      f'twice its uncertainty')
+            reason = f'no payload: {self._absent()}'
             why['payload.com'] = why['payload.inertia'] = reason
         else:
-            bad = [a for a, ok in zip('xyz', d['com']) if not ok]
+            bad = [f'{a} ({1000 * x:.1f} mm +- {_u(1000 * u)})'
+                   for a, x, u, ok in zip('xyz', self.com, self.com_std,
+                                          d['com']) if not ok]
             if bad:
                 why['payload.com'] = (f'{", ".join(bad)} not determined by '
                                       f'this motion')
-            bad = [k for k, ok in zip(INERTIA_NAMES, d['inertia']) if not ok]
+            bad = [f'{n} ({I[a, b]:.2g} +- {_u(u)})' for n, (a, b), u, ok
+                   in zip(INERTIA_NAMES, INERTIA_KEYS, self.inertia_std,
+                          d['inertia']) if not ok]
             if bad:
                 why['payload.inertia'] = (
                     f'{", ".join(bad)} not determined by this motion (rotate '
                     f'the wrist about more axes)')
         out['undetermined'] = why
+        out['uncertainty'] = self.uncertainty()
         return out
+
+    def _absent(self):
+        return (f'the mass ({self.mass:.3g} kg +- {_u(self.mass_std)}) is '
+                f'below {MASS_ABS:g} kg or {PRESENT_SIGMAS:g} standard '
+                f'uncertainties')
 
     def settable(self):
         """Return the parameters the node can take as they are (no None)."""
@@ -234,12 +287,11 @@ class PayloadEstimate:
         """One line per quantity the recording does not determine."""
         out = []
         if not self.determined['mass']:
-            out.append(f'the mass is undetermined (standard error '
-                       f'{self.mass_std:.3g} kg)')
+            out.append(f'the mass is undetermined (estimate {self.mass:.3g} '
+                       f'kg, standard uncertainty {_u(self.mass_std)} kg)')
         if not self.determined['present']:
-            out.append(f'no payload: the mass is below {MASS_ABS:g} kg or '
-                       f'twice its uncertainty; centre of mass and inertia '
-                       f'are meaningless')
+            out.append(f'no payload: {self._absent()}; centre of mass and '
+                       f'inertia are meaningless')
             return out
         bad = [a for a, ok in zip('xyz', self.determined['com']) if not ok]
         if bad:
@@ -257,30 +309,31 @@ class PayloadEstimate:
         """Return a readable summary (``payload`` without --json)."""
         d = self.determined
         lines = [f'payload fixed to {tip}, from {self.samples} samples over '
-                 f'{self.duration:.1f} s']
+                 f'{self.duration:.1f} s (+- one standard uncertainty)']
         if d['mass']:
-            lines.append(f'  mass         {self.mass:.4g} kg  '
-                         f'(+-{self.mass_std:.2g})')
+            lines.append(f'  mass         {self.mass:.3f} kg  '
+                         f'(+-{_u(self.mass_std)})')
         else:
             lines.append(f'  mass         undetermined (estimate '
-                         f'{self.mass:.3g} kg, +-{self.mass_std:.2g})')
+                         f'{self.mass:.3g} kg, +-{_u(self.mass_std)})')
         if not d['present']:
-            lines.append(f'  no payload: the mass is below {MASS_ABS:g} kg '
-                         f'or twice its uncertainty (centre of mass and '
-                         f'inertia not reported)')
+            lines.append(f'  no payload: {self._absent()} (centre of mass '
+                         f'and inertia not reported)')
         else:
             cells = []
             for a in range(3):
-                cells.append(f'{1000 * self.com[a]:.1f} mm (+-'
-                             f'{1000 * self.com_std[a]:.2g})'
-                             if d['com'][a] else 'undetermined')
+                text = (f'{1000 * self.com[a]:.1f} mm (+-'
+                        f'{_u(1000 * self.com_std[a])})')
+                cells.append(text if d['com'][a]
+                             else f'undetermined (estimate {text})')
             lines.append(f'  com ({tip} frame)  x {cells[0]}, y {cells[1]}, '
                          f'z {cells[2]}')
             cells = []
             for k, (a, b) in enumerate(INERTIA_KEYS):
-                cells.append(f'{INERTIA_NAMES[k]} '
-                             + (f'{self.inertia[a, b]:.3g}'
-                                if d['inertia'][k] else 'undetermined'))
+                text = (f'{self.inertia[a, b]:.2g} (+-'
+                        f'{_u(self.inertia_std[k])})')
+                cells.append(f'{INERTIA_NAMES[k]} ' + (
+                    text if d['inertia'][k] else 'undetermined'))
             lines.append('  inertia about the com (kg m^2): '
                          + ', '.join(cells))
         lines.append('torque residual per joint, RMS N m (arm model alone -> '
@@ -291,6 +344,11 @@ class PayloadEstimate:
         for line in self.undetermined_lines():
             lines.append(f'note: {line}')
         return lines
+
+
+def _u(u):
+    """Format an uncertainty in two digits, or 'unbounded'."""
+    return f'{u:.2g}' if np.isfinite(u) and u < UNBOUNDED else 'unbounded'
 
 
 def _solve_sdp(Rw, zw, prior):
@@ -341,8 +399,11 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None,
             tau = tau + drives.torques(qd, qdd)
             # a motor current's torque: the torque constants of the URDF
             effort = drives.effort_to_torque(effort)
-        Y = regressor_batch(model, q, qd, qdd)[:, sees, cols]
-        return Y @ T, (effort - tau)[:, sees]
+        Y = regressor_batch(model, q, qd, qdd)[:, sees, cols] @ T
+        y = (effort - tau)[:, sees]
+        blocks.append(_block_grams(Y, y))
+        return Y, y
+    blocks = []
     red, _, info = reduce_recording(path, model.joint_names, rows,
                                     N_INERTIAL, topic, cutoff, split=False,
                                     outputs=len(sees))
@@ -374,20 +435,9 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None,
         c = np.zeros(3)
         Ic = np.zeros((3, 3))
     Ic = 0.5 * (Ic + Ic.T)
-    # uncertainty: the residual is mostly model error, not white noise, so
-    # the bound is what a change of the parameters as large as the
-    # residual (RMS over all rows, weighted) could hide, not the white-
-    # noise standard error (smaller by sqrt(rows))
-    total = max(int(red.rows.sum()), 1)
-    res_w = np.sqrt(np.sum(red.sq_residuals(pi) * w ** 2) / total)
-    res_w = np.sqrt(total) * res_w
-    Ds = np.maximum(D, 1e-300)
-    Rs = Rw / Ds
-    U, s, Vt = np.linalg.svd(Rs)
-    keep = s > 1e-12 * s[0]
-    inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 1e30)
-    cov = (Vt.T * inv_s2) @ Vt / np.outer(Ds, Ds) * res_w ** 2
-    est = _uncertainty(m, c, Ic, pi, cov)
+    theta_w = np.linalg.lstsq(Rw, zw, rcond=1e-12)[0]
+    covs = _covariance(Rw, D, red, w, theta_w, np.vstack(blocks))
+    est = _uncertainty(m, c, Ic, pi, covs)
     est.samples = info['samples']
     est.duration = info['duration']
     est.residual_before = np.sqrt(red.sq_effort() / rows)
@@ -396,7 +446,63 @@ def estimate_payload(model, path, topic='/joint_states', cutoff=None,
     return est
 
 
-def _uncertainty(m, c, Ic, pi, cov):
+def _block_grams(Y, y):
+    """
+    (blocks, n, 11, 11) Gram matrices of [Y_j | y_j] per block of rows.
+
+    A block is ``BLOCK_ROWS`` consecutive rows (the last of a chunk may
+    be shorter): the residual is correlated over a few cutoff periods
+    and the arm model's error over longer, and a block's summed score
+    carries both.
+    """
+    M = np.concatenate([Y, y[:, :, None]], axis=2)
+    return np.stack([np.einsum('bni,bnj->nij', M[a:a + BLOCK_ROWS],
+                               M[a:a + BLOCK_ROWS])
+                     for a in range(0, max(len(M), 1), BLOCK_ROWS)])
+
+
+def _covariance(Rw, D, red, w, theta, grams):
+    """
+    Estimates of the covariance of the ten parameters (weighted fit).
+
+    White noise through the filter: s^2 (A^T W A)^-1 times the rows per
+    independent sample (the filtered effort carries nothing above the
+    cutoff and rows are FIT_RATE_FACTOR per cutoff period: Nyquist gives
+    two independent samples per period), s^2 the weighted residual
+    variance.  Blocks: the sandwich H^-1 (sum_b s_b s_b^T) H^-1 of the
+    blocks' scores s_b = A_b^T W r_b, which holds when the residual is
+    correlated over longer (the arm model's error follows the motion).
+    Blocks of 2 s and 8 s too where the recording has twice as many as
+    there are parameters.  A direction the motion does not excite gets
+    an inverse of 1e30.
+    """
+    Ds = np.maximum(D, 1e-300)
+    U, s, Vt = np.linalg.svd(Rw / Ds)
+    keep = s > 1e-12 * s[0]
+    inv_s2 = np.where(keep, 1.0 / np.where(keep, s, 1.0) ** 2, 1e30)
+    Hinv = (Vt.T * inv_s2) @ Vt / np.outer(Ds, Ds)
+    total = float(red.rows.sum())
+    dof = max(total - float(keep.sum()), 1.0)
+    s2 = float(np.sum(red.sq_residuals(theta) * w ** 2)) / dof
+    white = Hinv * s2 * (FIT_RATE_FACTOR / 2.0)
+    w2 = w ** 2
+    p = N_INERTIAL
+    scores = (np.einsum('j,bji->bi', w2, grams[:, :, :p, p])
+              - np.einsum('j,bjik,k->bi', w2, grams[:, :, :p, :p], theta))
+    out = [white]
+    # blocks of 0.5 s and, where there are enough of them, 2 s and 8 s:
+    # the arm model's error is correlated over more than half a second
+    for group in (1, 4, 16):
+        nb = len(scores) // group
+        if group > 1 and nb < 2 * p:
+            break
+        s_b = np.add.reduceat(scores, np.arange(0, len(scores), group))
+        meat = s_b.T @ s_b * (len(s_b) / max(len(s_b) - 1.0, 1.0))
+        out.append(Hinv @ meat @ Hinv)
+    return out
+
+
+def _uncertainty(m, c, Ic, pi, covs):
     """Propagate the covariance of pi to m, c and I_c (delta method)."""
     def quantities(p):
         mm = p[0]
@@ -413,18 +519,22 @@ def _uncertainty(m, c, Ic, pi, cov):
         dp = pi.copy()
         dp[k] += h
         G[:, k] = (quantities(dp) - base) / h
-    var = np.maximum(np.einsum('ik,kl,il->i', G, cov, G), 0.0)
-    std = np.sqrt(var)
+    # each quantity's variance: the largest of the estimates
+    var = np.max([np.einsum('ik,kl,il->i', G, cov, G) for cov in covs],
+                 axis=0)
+    std = np.sqrt(np.maximum(var, 0.0))
     mass_std = float(std[0])
     com_std = std[1:4]
     in_std = std[4:]
     # a payload is there when its mass stands out of its uncertainty
-    present = m >= max(MASS_ABS, 2.0 * mass_std)
-    mass_ok = mass_std <= max(MASS_TOL * m, MASS_TOL_ABS)
-    com_ok = [bool(present and com_std[a] <= COM_TOL) for a in range(3)]
+    present = m >= max(MASS_ABS, PRESENT_SIGMAS * mass_std)
+    mass_ok = K_EXPAND * mass_std <= max(MASS_TOL * m, MASS_TOL_ABS)
+    com_ok = [bool(present and K_EXPAND * com_std[a] <= COM_TOL)
+              for a in range(3)]
     ref = max([abs(Ic[a, b]) for a, b in INERTIA_KEYS] + [0.0])
     in_tol = max(INERTIA_TOL * ref, INERTIA_ABS)
-    in_ok = [bool(present and in_std[k] <= in_tol) for k in range(6)]
+    in_ok = [bool(present and K_EXPAND * in_std[k] <= in_tol)
+             for k in range(6)]
     if not present:
         c = np.zeros(3)
         Ic = np.zeros((3, 3))

@@ -110,7 +110,7 @@ def test_mass_and_com_from_a_recording(loaded):
     with open(loaded['truth'], encoding='utf-8') as f:
         truth = json.load(f)
     assert set(est) == {'payload.mass', 'payload.com', 'payload.inertia',
-                        'undetermined'}
+                        'undetermined', 'uncertainty'}
     assert len(est['payload.com']) == 3 and len(est['payload.inertia']) == 6
     # this motion determines the mass and the centre of mass: numbers
     assert est['payload.mass'] is not None
@@ -133,6 +133,44 @@ def test_mass_and_com_from_a_recording(loaded):
         ev = np.linalg.eigvalsh(Ic)
         assert ev.min() >= -1e-9
         assert ev.sum() - 2 * ev.max() >= -1e-9
+
+
+def test_each_value_is_within_its_uncertainty(loaded):
+    # issue 37: the confidence behind each value, as numbers; the truth
+    # within three standard uncertainties of every value given
+    code, out, err = payload_cli(loaded, '--json')
+    assert code == 0, err
+    est = json.loads(out)
+    with open(loaded['truth'], encoding='utf-8') as f:
+        truth = json.load(f)
+    u = est['uncertainty']
+    for key in ('payload.mass', 'payload.com', 'payload.inertia'):
+        got, want, sd = (np.atleast_1d(np.asarray(x, dtype=float))
+                         for x in (est[key], truth[key], u[key]))
+        given = ~np.isnan(got)
+        assert np.all(sd > 0), (key, sd)
+        assert np.all(np.abs(got - want)[given] <= 3 * sd[given]), (
+            key, got, want, sd)
+    # the mass and the centre of mass come out well inside the 15 mm a
+    # payload's com is asked for (the errors are a tenth of a millimetre)
+    assert max(u['payload.com']) <= 1e-3, u['payload.com']
+
+
+def test_uncertainty_shrinks_with_a_longer_recording(loaded, tmp_path):
+    # issue 37: the bound was the whole residual's norm through
+    # (A^T A)^-1, the same for 5 s as for 20 s (7 mm on both), so a longer
+    # recording never determined more.  The first 5 s of the same motion:
+    # four times the samples give about half the uncertainty
+    short = make_example(str(tmp_path / 'short'), mass=1.5,
+                         com=(0.01, -0.02, 0.06), seconds=5.0, seed=4)
+    u = {}
+    for name, paths in (('short', short), ('long', loaded)):
+        code, out, err = payload_cli(paths, '--json')
+        assert code == 0, err
+        u[name] = json.loads(out)['uncertainty']
+    assert u['long']['payload.mass'] <= 0.75 * u['short']['payload.mass']
+    for a, b in zip(u['long']['payload.com'], u['short']['payload.com']):
+        assert a <= 0.75 * b, (u['long'], u['short'])
 
 
 def test_a_heavy_payload_is_not_taken_for_currents(tmp_path):
