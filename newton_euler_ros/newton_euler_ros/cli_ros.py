@@ -43,17 +43,16 @@ arrival time as the recording time: what ``identify``, ``payload`` and
 unless a publisher on the topic is best effort.  It stops after
 ``--duration`` seconds of recording, ``--max-messages`` messages, or on
 Ctrl-C (SIGINT), SIGTERM or SIGHUP (a closed terminal or ssh session);
-the bag is complete in every case.  What it has recorded reaches the disk
-every ``SYNC_S`` seconds (a closed MCAP chunk, fsynced; a committed
-sqlite3 transaction), so a SIGKILL or a power cut loses at most that
-much, and the reading commands recover the rest.
+the bag is complete in every case.  Its lag behind the stream is bounded
+(messages it could not take in time are dropped and counted) and what
+it has recorded reaches the disk four times a second, so a SIGKILL or a
+power cut loses under a second: ``cli_record``.
 
 Both need rclpy (the ROS 2 wheels of ``make setup``); every other command
 of ``newton-euler`` runs without it.
 """
 import math
 import os
-import shutil
 import signal
 import sys
 import time
@@ -64,7 +63,6 @@ MAX_TRAJECTORY_BYTES = 64 * 1024 * 1024
 MAX_POINTS = 1_000_000
 FIELDS = ('positions', 'velocities', 'accelerations', 'effort')
 JOINT_STATE = 'sensor_msgs/msg/JointState'
-SYNC_S = 0.5          # record: what is recorded is on the disk this often
 
 
 class RosCliError(Exception):
@@ -125,7 +123,7 @@ def register(subparsers):
     rec.add_argument('--wait', type=float, default=30.0, metavar='S',
                      help='seconds to wait for a publisher (default '
                           '%(default)s)')
-    rec.set_defaults(func=cmd_record)
+    rec.set_defaults(func=_record)
 
 
 # ---- the trajectory file -------------------------------------------------
@@ -444,121 +442,10 @@ def cmd_send(args):
     return 0
 
 
-class _Recorder:
-    """Writes each raw JointState to the bag as it arrives."""
-
-    def __init__(self, args):
-        self.args = args
-        self.writer = self.conn = None
-        self.count = 0
-        self.first = self.last = None
-
-    def start(self):
-        from .ident.bag_write import open_writer, sync_directory, sync_writer
-        self.writer, self.conn, _ = open_writer(self.args.bag,
-                                                self.args.topic,
-                                                self.args.storage)
-        self._sync = sync_writer
-        sync_writer(self.writer)
-        sync_directory(self.args.bag)
-        sync_directory(os.path.dirname(os.path.abspath(self.args.bag)))
-
-    def sync(self):
-        """Put what is recorded on the disk (a timer calls it)."""
-        if self.writer is not None and self.count:
-            self._sync(self.writer)
-
-    def __call__(self, raw):
-        now = time.time_ns()
-        if self.done():
-            return
-        self.writer.write(self.conn, now, bytes(raw))
-        self.count += 1
-        self.first = now if self.first is None else self.first
-        self.last = now
-
-    def done(self):
-        a = self.args
-        return ((a.max_messages is not None and self.count >= a.max_messages)
-                or (a.duration is not None and self.first is not None
-                    and self.last - self.first >= a.duration * 1e9))
-
-    def close(self):
-        if self.writer is not None:
-            self.writer.close()
-
-
-def _check_record_args(args):
-    bag = args.bag
-    if os.path.lexists(bag):
-        raise RosCliError(f'{bag}: already exists (a recording is never '
-                          f'overwritten)')
-    parent = os.path.dirname(os.path.abspath(bag))
-    if not os.path.isdir(parent):
-        raise RosCliError(f'{bag}: no such directory {parent}')
-    _check_seconds(args.wait, '--wait')
-    if args.duration is not None:
-        _check_seconds(args.duration, '--duration', allow_zero=False)
-    if args.max_messages is not None and args.max_messages < 1:
-        raise RosCliError(f'--max-messages: must be >= 1, got '
-                          f'{args.max_messages}')
-
-
-def _publishers(ros, topic):
-    """(types, any best effort) of the publishers on ``topic``."""
-    from rclpy.qos import ReliabilityPolicy
-    infos = ros.node.get_publishers_info_by_topic(topic)
-    return ({i.topic_type for i in infos},
-            any(i.qos_profile.reliability == ReliabilityPolicy.BEST_EFFORT
-                for i in infos))
-
-
-def cmd_record(args):
-    """Record JointState messages into a new rosbag2."""
-    _check_record_args(args)
-    from rclpy.qos import QoSProfile, ReliabilityPolicy
-    from sensor_msgs.msg import JointState
-    ros = _Ros('newton_euler_record')
-    rec = _Recorder(args)
-    try:
-        topic = ros.node.resolve_topic_name(args.topic)
-        if not ros.spin_until(lambda: _publishers(ros, topic)[0],
-                              args.wait):
-            if ros.stop:
-                return 130
-            raise RosGraphError(f'no publisher on {topic} after '
-                                f'{args.wait:g} s (is the robot driver '
-                                f'running, in this ROS_DOMAIN_ID?)')
-        types, best_effort = _publishers(ros, topic)
-        if types != {JOINT_STATE}:
-            raise RosCliError(f'{topic} carries {", ".join(sorted(types))}, '
-                              f'not {JOINT_STATE}')
-        rec.start()
-        ros.node.create_subscription(
-            JointState, topic, rec, QoSProfile(
-                depth=1000, reliability=ReliabilityPolicy.BEST_EFFORT
-                if best_effort else ReliabilityPolicy.RELIABLE), raw=True)
-        ros.node.create_timer(SYNC_S, rec.sync)
-        _say(f'recording {topic} into {args.bag} '
-             f'({"best effort" if best_effort else "reliable"}); Ctrl-C '
-             f'stops')
-        ros.spin_until(rec.done, None)
-    finally:
-        rec.close()
-        ros.close()
-    if not rec.count:
-        if rec.writer is not None:
-            shutil.rmtree(args.bag, ignore_errors=True)
-        _say(f'newton-euler: no message received on {args.topic}; no bag '
-             f'written', sys.stderr)
-        return 1
-    seconds = (rec.last - rec.first) * 1e-9
-    how = {signal.SIGINT: ' (Ctrl-C)', signal.SIGTERM: ' (SIGTERM)',
-           signal.SIGHUP: ' (SIGHUP)'}.get(ros.stop[0] if ros.stop else None,
-                                           '')
-    _say(f'recorded {rec.count} messages on {topic} over {seconds:.1f} s '
-         f'into {args.bag}{how}')
-    return 0
+def _record(args):
+    """``record`` (cli_record: the recorder, its lag and its drops)."""
+    from .cli_record import cmd_record
+    return cmd_record(args)
 
 
 def _say(text, stream=None):

@@ -147,7 +147,7 @@ def test_sighup_and_sigterm_leave_a_complete_bag(tmp_path, sig):
     assert (sent[-1] - states.stamps_ns[-1]) * 1e-9 < 0.2
 
 
-# killed at different phases of record's half-second sync
+# killed at different phases of record's quarter-second sync
 @pytest.mark.parametrize('storage, seconds', [('mcap', 3.25),
                                               ('sqlite3', 3.45)])
 def test_sigkill_loses_at_most_a_second(tmp_path, storage, seconds):
