@@ -58,6 +58,9 @@ INT = types.int64
 BOOL = types.boolean
 
 
+_F64 = np.dtype(np.float64)     # compared by identity first: cheaper
+
+
 class Refused(Exception):
     """A strict entry was given an argument of another type: convert it."""
 
@@ -101,7 +104,8 @@ def workspace(model, ws):
     if ws is None:
         return model.default_workspace
     if type(ws) is not Workspace or ws.n != model.n \
-            or ws.nb != model.nb or ws.dtype != np.float64:
+            or ws.nb != model.nb or (ws.dtype is not _F64
+                                     and ws.dtype != _F64):
         raise DynamicsInputError(
             f'ws must be a float64 Workspace for a model of {model.n} '
             f'joints, got {ws!r}')
@@ -155,6 +159,18 @@ def inputs(ws, names, q, qd=None, third=None, wrench=None):
     are overwritten by the next call on ``ws``: use them at once.
     """
     n = ws.n
+    if (type(q) is list and type(qd) is list and type(third) is list
+            and len(q) == n and len(qd) == n and len(third) == n):
+        # the common case, three (or four) lists: one copy into the rows
+        try:
+            if wrench is None:
+                ws.given[:3 * n] = q + qd + third
+                return ws.given_three
+            if type(wrench) is list and len(wrench) == 6:
+                ws.given[:] = q + qd + third + wrench
+                return ws.given_four
+        except (TypeError, ValueError):
+            pass                # one at a time below: vector() names it
     given = (q, qd, third, wrench)
     out = [ws.zeros, ws.zeros, ws.zeros, ws.zero_wrench]
     for i in range(4):
@@ -178,7 +194,9 @@ def out_array(out, shape, dtype=np.float64):
     """Return a new array of ``shape``, or ``out`` once checked."""
     if out is None:
         return np.empty(shape, dtype)
-    if (type(out) is not np.ndarray or out.dtype != dtype
+    want = _F64 if dtype is np.float64 else np.dtype(dtype)
+    if (type(out) is not np.ndarray
+            or (out.dtype is not want and out.dtype != want)
             or out.shape != shape or not out.flags.c_contiguous
             or not out.flags.writeable):
         raise DynamicsInputError(

@@ -187,10 +187,10 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
 
 def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
     """Call the Newton-Euler entry again, its arguments converted once."""
-    ws = workspace(model, ws)
+    ws = model.default_workspace if ws is None else workspace(model, ws)
     n = ws.n
     q, qd, qdd, wrench = inputs(ws, INPUTS, q, qd, qdd, wrench)
-    tau = out_array(out, (n,))
+    tau = np.empty(n) if out is None else out_array(out, (n,))
     code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
     if code >= 0:
         raise status_error(code, (q, qd, qdd, wrench))

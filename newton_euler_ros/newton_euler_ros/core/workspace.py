@@ -50,9 +50,13 @@ class Workspace:
         self.zero_wrench = np.zeros(6, dtype)
         self.status = np.zeros(1, np.int64)
         # inputs given as lists or tuples, copied in (calling.sequences_in)
-        self.given = np.zeros((3, n), dtype)
-        self.given_rows = tuple(self.given)
-        self.given_wrench = np.zeros(6, dtype)
+        self.given = np.zeros(3 * n + 6, dtype)
+        self.given_rows = (self.given[:n], self.given[n:2 * n],
+                           self.given[2 * n:3 * n])
+        self.given_wrench = self.given[3 * n:]
+        # what calling.inputs returns for three lists, and for four
+        self.given_three = (*self.given_rows, self.zero_wrench)
+        self.given_four = (*self.given_rows, self.given_wrench)
 
     def __repr__(self):
         """Return e.g. ``Workspace(n=6, float64)``."""
