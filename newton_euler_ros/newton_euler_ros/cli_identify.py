@@ -415,8 +415,8 @@ def cmd_replay(args):
     from .core import NewtonEulerError
     from .core.drives import model_drives
     from .ident.bag import read_joint_states
-    from .ident.fit import predict
     from .ident.signals import prepare
+    from .ident.torques import predict
     for opt, path in (('--csv', args.csv), ('--plot', args.plot)):
         if path is not None and not os.path.isdir(
                 os.path.dirname(os.path.abspath(path))):

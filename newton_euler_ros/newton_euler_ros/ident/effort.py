@@ -111,13 +111,13 @@ def recording_mismatch(label, model, stamps, q, qd, effort, urdf, fix):
     :func:`mismatch` on a recording (stamps, q, qd or None, effort).
 
     The state filtered as identification filters it (``signals.prepare``),
-    the model's torque with its drive terms (``fit.predict``); None when
+    the model's torque with its drive terms (``torques.predict``); None when
     the efforts can be what the model's URDF says, or the recording is
     too short to tell.
     """
     from ..core.drives import model_drives
-    from .fit import predict
     from .signals import prepare
+    from .torques import predict
     try:
         prep = prepare(stamps, q, qd, effort)
     except ValueError:              # too short or too slow to filter

@@ -563,12 +563,3 @@ def _clean(theta, fixed, nb, n):
         d[:, col] = np.maximum(d[:, col], 0.0)
     theta[N_INERTIAL * nb:] = d.ravel()
     return theta
-
-
-def predict(model, drives, Q, QD, QDD):
-    """Model torques (rigid body + drives) at (m, n) states."""
-    from ..core import inverse_dynamics_batch
-    tau = inverse_dynamics_batch(model, Q, QD, QDD)
-    if drives is not None:
-        tau += drives.torques(QD, QDD)
-    return tau
