@@ -18,7 +18,8 @@
     newton-euler excite MODEL.urdf --base LINK --tip LINK -o TRAJECTORY.json
                         --start Q1 ... QN [--period S] [--harmonics K]
                         [--seconds S] [--seed N] [--rate HZ] [--budget S]
-                        [--range JOINT LO HI] [--max-velocity V [V ...]]
+                        [--evaluations N] [--range JOINT LO HI]
+                        [--max-velocity V [V ...]]
                         [--max-acceleration A [A ...]] [--clearance M]
                         [--floor Z | --no-floor] [--plane NX NY NZ D]
                         [--box XMIN YMIN ZMIN XMAX YMAX ZMAX]
@@ -75,6 +76,10 @@ def register(subparsers):
                      help='trajectory points per second (default 50)')
     exc.add_argument('--budget', type=float, default=40.0, metavar='S',
                      help='optimisation time budget, s (default 40)')
+    exc.add_argument('--evaluations', type=int, metavar='N',
+                     help='stop the optimisation after N evaluations of '
+                     'the condition number (the same motion on any '
+                     'machine for a seed; default: the time budget only)')
     exc.add_argument('--range', nargs=3, action='append', default=[],
                      metavar=('JOINT', 'LO', 'HI'),
                      help='keep JOINT in [LO, HI], inside its URDF limits '
@@ -146,6 +151,8 @@ def cmd_excite(args):
                    ('--budget', args.budget)):
         if v is not None and not (v > 0 and math.isfinite(v)):
             _fail(f'{opt} must be a positive number, got {v:g}')
+    if args.evaluations is not None and args.evaluations < 1:
+        _fail(f'--evaluations must be at least 1, got {args.evaluations}')
     model, text, notes = _model(args.model, args.base, args.tip)
     for line in notes:
         print(line, file=sys.stderr)
@@ -155,7 +162,8 @@ def cmd_excite(args):
         clearance = _clearance(args, model, text)
         exc = excite(model, period=args.period, harmonics=args.harmonics,
                      seed=args.seed, start=args.start, budget=args.budget,
-                     limits=limits, clearance=clearance)
+                     limits=limits, clearance=clearance,
+                     evaluations=args.evaluations)
     except NewtonEulerError as exc_:
         _fail(f'{args.model}: {exc_}')
     for line in exc.limits.notes:

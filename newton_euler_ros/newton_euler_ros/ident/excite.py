@@ -399,9 +399,14 @@ def check_feasible(model, limits, start, period, harmonics):
 
 def excite(model, period=10.0, harmonics=5, seed=0, start=None,
            budget=TIME_BUDGET, coulomb_width=0.02, limits=None,
-           clearance=None):
+           clearance=None, evaluations=None):
     """
     Return the optimised :class:`Excitation` of ``model``.
+
+    The optimisation stops at ``budget`` seconds, or after
+    ``evaluations`` evaluations of the condition number if that comes
+    first: with a count, the same seed gives the same motion on any
+    machine, however loaded.
 
     ``limits``: :class:`Limits` (default the model's, see
     :func:`narrowed`); ``clearance``: an ``ident.clearance.Clearance`` to
@@ -443,7 +448,8 @@ def excite(model, period=10.0, harmonics=5, seed=0, start=None,
         pass
 
     def fun(x):
-        if time.perf_counter() > deadline:
+        if time.perf_counter() > deadline or (
+                evaluations is not None and prob.evaluations >= evaluations):
             raise _Stop
         f = prob.log_condition(x)
         if f < best['f']:

@@ -49,7 +49,18 @@ def panda():
 
 @pytest.fixture(scope='module')
 def excitation(panda):
-    return excite(panda, period=8.0, harmonics=4, seed=1, budget=8.0)
+    # a count of evaluations, not seconds: the same motion however loaded
+    return excite(panda, period=8.0, harmonics=4, seed=1, budget=120.0,
+                  evaluations=150)
+
+
+def test_a_count_of_evaluations_gives_the_same_motion(panda, excitation):
+    again = excite(panda, period=8.0, harmonics=4, seed=1, budget=120.0,
+                   evaluations=150)
+    assert excitation.evaluations == again.evaluations == 150
+    np.testing.assert_array_equal(again.a, excitation.a)
+    np.testing.assert_array_equal(again.b, excitation.b)
+    assert again.condition < excitation.condition_random
 
 
 def test_rest_at_both_ends_at_the_start(panda, excitation):

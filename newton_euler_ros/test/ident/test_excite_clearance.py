@@ -34,7 +34,8 @@ import pytest
 UR5 = example_robot_urdf('ur_description/urdf/ur5_robot.urdf')
 HOME = [0.0, -np.pi / 2, np.pi / 2, -np.pi / 2, -np.pi / 2, 0.0]
 MARGIN = 0.05
-QUICK = ['--period', '8', '--harmonics', '4', '--budget', '4']
+QUICK = ['--period', '8', '--harmonics', '4', '--budget', '120',
+         '--evaluations', '120']   # the same motion however loaded
 
 
 def excite(tmp_path, *args, name='x.json'):
