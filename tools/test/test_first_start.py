@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-The first start on a whole robot, as a user starts the node.
+The first start on a whole robot, as a user starts the node; latency.
 
 TIAGo Pro from ``robot_file`` with the observer, states of its 33 joints
 at 100 Hz from the moment the process starts: the kernels come from the
@@ -45,3 +45,7 @@ def test_first_start_loads_the_kernels_and_answers_every_state():
     assert 'not compiled ahead' not in out, out
     answered, sent = out.split('then ')[1].split(' answered')[0].split(' of ')
     assert int(answered) == int(sent) >= 90, out
+    # the latency phase at 500 Hz, and the node's own time per update
+    # from /diagnostics (figures printed, not judged)
+    assert 'at 500 Hz: ' in out and "the node's time per update " \
+        '(/diagnostics) median ' in out, out

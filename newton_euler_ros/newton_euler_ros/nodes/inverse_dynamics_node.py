@@ -60,7 +60,7 @@ from .common import (check_parameters, ConfigurationError,
                      release_memory, run_node, seconds, SharedGraphNode)
 from .inverse_dynamics_reports import (answer, diagnostics, failed,
                                        mimic_line, model_line,
-                                       no_model_text)
+                                       no_model_text, UpdateTimes)
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
@@ -101,6 +101,7 @@ class InverseDynamicsNode(SharedGraphNode):
         self._over_log = collections.defaultdict(OverLimitLog)
         self.ff = None          # swapped whole when a new model arrives
         self.kernels = KernelTimer(self.get_logger())
+        self.update_times = UpdateTimes()
         self.model_source = ''
         #: why the last robot_description was rejected ('' when it loaded)
         self.description_rejected = ''
@@ -343,6 +344,12 @@ class InverseDynamicsNode(SharedGraphNode):
         self.counts['no_model'] += 1
 
     def _on_joint_state(self, msg):
+        start = time.perf_counter()
+        if self._answer_joint_state(msg):
+            self.update_times.add(time.perf_counter() - start)
+
+    def _answer_joint_state(self, msg):
+        """Publish the torques of one joint state; True when published."""
         ff = self.ff
         if ff is None:
             self._no_model('joint state')
@@ -392,6 +399,7 @@ class InverseDynamicsNode(SharedGraphNode):
         self.counts['published'] += 1
         if self._observer is not None:
             self._observer.observe(ff, msg, self._reject)
+        return True
 
     def _over_limit(self, ff, what, over):
         """Count a torque over its bound; say which once per change."""
@@ -491,6 +499,8 @@ class InverseDynamicsNode(SharedGraphNode):
                              self.counts, self.mode, self.params,
                              self.payload, self.model_source,
                              self.description_rejected)
+        status.append(self.update_times.status(
+            self.get_fully_qualified_name()))
         if self._observer is not None:
             status.append(self._observer.diagnostics())
         msg = DiagnosticArray(status=status)

@@ -23,6 +23,7 @@ listing a whole robot's mimic joints), the two statuses of its
 terms, :func:`failed`).
 """
 from diagnostic_msgs.msg import DiagnosticStatus, KeyValue
+import numpy as np
 
 from ..core.text import clip
 
@@ -151,3 +152,44 @@ def diagnostics(name, ff, counts, mode, params, payload, source, rejected):
         KeyValue(key='torque_bound_sources', value=repr(
             ff.bound_sources if ff is not None else []))]
     return [status, model]
+
+
+class UpdateTimes:
+    """
+    The time each joint state took, from its callback to the publish.
+
+    The last ``size`` updates are kept in a ring (no allocation per
+    update); :meth:`status` gives their median, 99th percentile and
+    largest in microseconds for ``/diagnostics`` (the observer's step is
+    included when it runs).
+    """
+
+    def __init__(self, size=1000):
+        self.times = np.zeros(size)
+        self.count = 0
+
+    def add(self, seconds):
+        """Record one update's duration."""
+        self.times[self.count % len(self.times)] = seconds
+        self.count += 1
+
+    def status(self, name):
+        """Return the DiagnosticStatus of the last updates' times."""
+        status = DiagnosticStatus(level=DiagnosticStatus.OK,
+                                  name=name + ': update time')
+        kept = self.times[:min(self.count, len(self.times))] * 1e6
+        if not len(kept):
+            status.message = 'no joint state answered yet'
+            status.values = [KeyValue(key='updates', value='0')]
+            return status
+        median, p99 = np.percentile(kept, [50, 99])
+        status.message = (f'joint state to torques, the last {len(kept)} '
+                          f'updates: median {median:.0f} us, 99th '
+                          f'percentile {p99:.0f} us')
+        status.values = [
+            KeyValue(key='updates', value=str(self.count)),
+            KeyValue(key='window', value=str(len(kept))),
+            KeyValue(key='median_us', value=f'{median:.1f}'),
+            KeyValue(key='p99_us', value=f'{p99:.1f}'),
+            KeyValue(key='max_us', value=f'{kept.max():.1f}')]
+        return status

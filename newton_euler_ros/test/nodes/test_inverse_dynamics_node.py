@@ -284,6 +284,21 @@ def test_never_published_non_finite(graph):
     assert all(np.isfinite(m.effort).all() for m in graph.torques)
 
 
+def test_diagnostics_give_the_time_per_update(graph, model):
+    """/diagnostics: median, 99th percentile and largest update time."""
+    for k in range(5):
+        assert graph.send_state([0.1 * k] * 6, [0.0] * 6) is not None
+    count = len(graph.diag)
+    assert graph.probe.spin_until(lambda: len(graph.diag) > count, 5.0)
+    status = next(s for s in graph.diag[-1].status
+                  if s.name.endswith(': update time'))
+    values = {kv.key: float(kv.value) for kv in status.values}
+    assert values['updates'] >= 5 and values['window'] >= 5
+    assert 0.0 < values['median_us'] <= values['p99_us'] <= \
+        values['max_us'] < 1e6
+    assert 'joint state to torques' in status.message
+
+
 def test_stops_cleanly(graph):
     assert graph.node.stop() == 0
     log = graph.node.log()
