@@ -62,7 +62,7 @@ from .inertia import format_moments, Note, principal_moments, triangle_note
 from .model import pose_matrix, rpy_matrix
 from .text import clip, read_text
 from .urdf_chain import chain_model
-from .urdf_tree import check_link, mimic_cycle
+from .urdf_tree import check_link, floating_root_base, mimic_cycle
 from .urdf_whole import tree_model
 from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
 
@@ -452,21 +452,25 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     """
     notes = []
     name, root, links, joints = parse_urdf(text, label, prior, notes)
+    floating = []
+    if base is None:    # below a floating or planar root, with a note
+        base, floating = floating_root_base(label, links, joints, root)
+        if tip is not None and tip == base:     # nothing left to move
+            base, floating = None, []
     if tip is None:
-        base = root if base is None else base
         check_link(label, links, 'base', base)
         model, found, report = tree_model(
             name, label, links, joints, base, gravity,
             lambda names: _chain_limits(joints, names),
             lambda names: read_drives(_parse(text, _Source(label)), names,
                                       label, prior, notes))
-        return model, _prior_note(label, notes) + found, report
+        return model, floating + _prior_note(label, notes) + found, report
     model, found, report = chain_model(
         name, label, links, joints, (root, base, tip), gravity,
         lambda names: _chain_limits(joints, names),
         lambda names: read_drives(_parse(text, _Source(label)), names,
                                   label, prior, notes))
-    return model, _prior_note(label, notes) + found, report
+    return model, floating + _prior_note(label, notes) + found, report
 
 
 def _prior_note(label, notes):

@@ -46,7 +46,8 @@ def _moving_joints(label, joints, chain, base, tip):
             raise RobotFileError(
                 f'{label}: joint {jname!r} type: a {kind} joint is on the '
                 f'chain from {base!r} to {tip!r}; only revolute, continuous,'
-                f' prismatic and fixed joints can be')
+                f' prismatic and fixed joints can be: start below it (base '
+                f'link {joints[jname].child!r})')
     moving = [j for j in chain if joints[j].kind in MOVING]
     if not moving:
         raise RobotFileError(f'{label}: no revolute, continuous or prismatic'

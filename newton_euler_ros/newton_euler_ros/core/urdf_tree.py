@@ -150,6 +150,29 @@ def mimic_cycle(joints):
     return None
 
 
+def floating_root_base(label, links, joints, root):
+    """
+    Return (base, notes): where a model starts when no base is given.
+
+    The root, unless the root's only child joint is ``floating`` or
+    ``planar`` (a mobile robot's ``odom -> base_footprint``, a humanoid's
+    ``world -> pelvis``): the model then starts at the first link below
+    it, fixed there, with a warning saying so (the node logs it, a
+    library call warns).
+    """
+    base, notes = root, []
+    while len(links[base].child_joints) == 1:
+        joint = joints[links[base].child_joints[0]]
+        if joint.kind not in ('floating', 'planar'):
+            break
+        notes.append(
+            f'{label}: {base!r} carries the rest through the {joint.kind} '
+            f'joint {joint.name!r}: the model starts at {joint.child!r}, '
+            f'fixed (give the base link to start elsewhere)')
+        base = joint.child
+    return base, notes
+
+
 def chain_ends(label, links, joints, root, base, tip):
     """
     Return (base, tip, joint names from base to tip) of a URDF tree.

@@ -75,8 +75,9 @@ class _Walk:
             raise RobotFileError(
                 f'{self.label}: joint {jname!r} type: a {joint.kind} joint '
                 f'is in the tree below the base; only revolute, continuous,'
-                f' prismatic and fixed joints can be (or give a tip link '
-                f'for a chain)')
+                f' prismatic and fixed joints can be: start below it (base '
+                f'link {joint.child!r}), or give a tip link whose chain '
+                f'avoids it')
         if joint.kind == 'fixed':
             self.fixed.append(jname)
             Tc = T @ joint.origin

@@ -365,6 +365,32 @@ def test_bad_trees_are_one_clear_error(text, message):
     assert '\n' not in str(info.value)
 
 
+@pytest.mark.parametrize('kind', ['floating', 'planar'])
+def test_a_floating_root_starts_the_model_below_it(kind):
+    """A root 'odom' -> 'base' (floating, planar): the model starts at base."""
+    from newton_euler_ros.core.urdf import urdf_model
+    text = torso().replace(
+        '</robot>', '<link name="odom"/>' + joint('odom_j', 'odom', 'base',
+                                                  kind) + '</robot>')
+    model, found, _ = urdf_model(text)
+    notes = [str(m) for m in found]
+    assert any(f"'odom' carries the rest through the {kind} joint "
+               f"'odom_j': the model starts at 'base', fixed" in m
+               for m in notes), notes
+    given, _, _ = urdf_model(text, base='base')
+    rng = np.random.default_rng(2)
+    q, qd, qdd = rng.uniform(-1, 1, (3, model.n))
+    assert model.joint_names == given.joint_names
+    assert np.array_equal(inverse_dynamics(model, q, qd, qdd),
+                          inverse_dynamics(given, q, qd, qdd))
+    # a chain to a tip too; the base given as the root says where to start
+    chain, _, _ = urdf_model(text, tip='la2')
+    assert chain.n == 3
+    with pytest.raises(RobotFileError,
+                       match=r'start below it \(base link .base.\)'):
+        urdf_model(text, base='odom')
+
+
 def test_mimic_cycle_of_two_joints_names_both():
     extra = ('<link name="fc">' + inertial() + '</link>'
              + joint('fc_j', 'ra2', 'fc', 'prismatic',

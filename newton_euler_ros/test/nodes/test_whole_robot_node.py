@@ -548,3 +548,51 @@ def test_the_start_up_line_counts_the_mimic_joints_the_next_lists_all(
                                for lead in dict.fromkeys(
                                    followers.values()))), listed
     assert '...' not in start + listed
+
+
+def test_a_description_with_a_floating_root_gets_torques(tmp_path):
+    """
+    The TIAGo Pro description below an ``odom`` link (a floating joint).
+
+    robot_state_publisher publishes it so on a mobile robot; the node
+    starts the model at base_footprint, says so, and answers states.
+    """
+    import time
+    from newton_euler_tools.peers import example_robot_urdf
+    path = example_robot_urdf('tiago_pro_description/robots/tiago_pro.urdf')
+    with open(path, encoding='utf-8') as fh:
+        text = fh.read()
+    text = text.replace('</robot>', (
+        '<link name="odom"/><joint name="odom_to_base" type="floating">'
+        '<parent link="odom"/><child link="base_footprint"/></joint>'
+        '</robot>'))
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_urdf(path)
+    domain = domain_id(43)
+    probe = Probe(domain)
+    description = probe.node.create_publisher(String, '/robot_description',
+                                              LATCHED)
+    description.publish(String(data=text))
+    node = NodeProcess(id_node_cmd(None), domain, str(tmp_path / 'node.log'))
+    try:
+        torques = probe.collect(JointState, f'{NODE}/torques')
+        states = probe.publisher(JointState, '/joint_states')
+        names = list(model.moving_joints)
+        deadline = time.monotonic() + 90.0
+        k = 0
+        while not torques:
+            assert node.alive() and time.monotonic() < deadline, node.log()
+            k += 1
+            states.publish(joint_state(names, [0.0] * len(names),
+                                       [0.0] * len(names),
+                                       probe.keyed_stamp(k)))
+            probe.spin_for(0.1)
+        assert len(torques[-1].effort) == model.n
+        assert np.isfinite(torques[-1].effort).all()
+    finally:
+        assert node.stop() == 0, node.log()
+        probe.close()
+    log = node.log()
+    assert ("'odom' carries the rest through the floating joint "
+            "'odom_to_base': the model starts at 'base_footprint'") in log, log
