@@ -29,6 +29,7 @@ import numpy as np
 
 from .core.inertia import format_moments, inertia_matrix, principal_moments
 from .core.model import with_payload
+from .core.text import clip
 from .feedforward import FeedforwardComputer
 from .joint_inputs import JointOrder, ReferenceTrajectory
 from .safety import effort_bounds
@@ -86,6 +87,31 @@ def is_whole_robot(model, tip_link=''):
     return bool(report and report.get('tree') and not tip_link)
 
 
+def locked_joints(model, p, commanded):
+    """Return {joint: position} of joint_states.lock; ValueError."""
+    names = list(p['joint_states.lock'])
+    values = list(p['joint_states.lock_positions'])
+    if len(names) != len(values):
+        raise ValueError(
+            f'joint_states.lock_positions: {len(values)} values for the '
+            f'{len(names)} joints of joint_states.lock')
+    for name, value in zip(names, values):
+        if name not in model.joint_names:
+            follower = name in model.moving_joints
+            raise ValueError(
+                f'joint_states.lock: {name!r} is '
+                + ('a mimic joint: lock its leader' if follower else
+                   f'not a joint of {model.name} (its joints: '
+                   f'{clip(list(model.joint_names), 300)})'))
+        if name in commanded:
+            raise ValueError(f'joint_states.lock: {name!r} is commanded '
+                             f'(joints): a commanded joint cannot be locked')
+        if not math.isfinite(value):
+            raise ValueError(f'joint_states.lock_positions: {name!r} at '
+                             f'{value!r}: must be finite')
+    return dict(zip(names, values))
+
+
 def build_computer(params, mode, model, payload, scene=None, previous=None):
     """
     Joint order, wrench input and a warm computer for a model.
@@ -136,5 +162,6 @@ def build_computer(params, mode, model, payload, scene=None, previous=None):
         ff.merger = JointStateMerger(
             model, order.output_joints[:order.command],
             p['joint_states.hold'], p['joint_states.mimic_tolerance'],
-            p['limits.max_names'])
+            p['limits.max_names'],
+            locked_joints(model, p, order.output_joints[:order.command]))
     return ff

@@ -48,6 +48,40 @@ def followers_of(model):
     return out
 
 
+def needed_coordinates(model, trigger):
+    """
+    Return which coordinates the torques of the ``trigger`` ones depend on.
+
+    A joint's torque depends on the joints above it (they move its
+    subtree) and below it (their bodies are what it carries), not on a
+    sibling branch: commanding one arm of a mobile manipulator needs its
+    torso and its own joints, never the wheels or the other arm.  Bodies
+    are mapped to coordinates through their leaders (a mimic follower's
+    leader counts where the follower's body does).
+    """
+    from .core.tree import coordinates, support
+    _, coord = coordinates(model.mimic)
+    parents = model.parents
+    nb = len(parents)
+    children = [[] for _ in range(nb)]
+    for b, p in enumerate(parents):
+        if p >= 0:
+            children[p].append(b)
+    marked = np.zeros(nb, dtype=bool)
+    for b in range(nb):
+        if not trigger[coord[b]] or marked[b]:
+            continue
+        marked[support(parents, b)] = True
+        stack = [b]
+        while stack:
+            c = stack.pop()
+            marked[c] = True
+            stack.extend(children[c])
+    needed = np.zeros(len(trigger), dtype=bool)
+    needed[[coord[b] for b in np.flatnonzero(marked)]] = True
+    return needed
+
+
 class _Names:
     """Where a name list's joints go: coordinates, followers, the rest."""
 
@@ -84,11 +118,16 @@ class JointStateMerger:
     tolerance : largest |q_f - (multiplier q_leader + offset)| accepted
         for a mimic joint (rad or m); 0 turns the check off.
     max_names : longer name lists are refused at once.
+    locked : {joint: position} held whatever the messages say (velocity
+        0); the joints neither commanded nor locked are required only if
+        the commanded ones' torques depend on them
+        (:func:`needed_coordinates`), else they take their latest value
+        (0 until one arrives).
 
     """
 
     def __init__(self, model, trigger, hold=0.5, tolerance=0.005,
-                 max_names=0):
+                 max_names=0, locked=None):
         self.names = tuple(model.joint_names)
         n = len(self.names)
         self.index = {name: k for k, name in enumerate(self.names)}
@@ -107,6 +146,17 @@ class JointStateMerger:
         #: node-clock time each joint was last received (-inf: never)
         self.seen = np.full(n, -np.inf)
         self._cache = {}
+        #: the joints the commanded ones' torques depend on: only these
+        #: must be received (a mobile base's wheels need not be)
+        self.needed = needed_coordinates(model, self.trigger)
+        #: joints held at given positions whatever the messages say
+        self.locked = np.zeros(n, dtype=bool)
+        self.locked_q = np.zeros(n)
+        for name, value in (locked or {}).items():
+            k = self.index[name]
+            self.locked[k], self.locked_q[k] = True, float(value)
+        self.needed &= ~self.locked
+        self.q[self.locked] = self.locked_q[self.locked]
 
     def _names(self, names):
         key = tuple(names)
@@ -170,9 +220,12 @@ class JointStateMerger:
             e = eff[where.take]
             self.effort[into] = np.where(np.isfinite(e), e, np.nan)
         self.seen[into] = now
+        if self.locked.any():
+            self.q[self.locked] = self.locked_q[self.locked]
+            self.qd[self.locked] = 0.0
         if not self.trigger[into].any():
             return None
-        old = self.seen < now - self.hold
+        old = (self.seen < now - self.hold) & self.needed
         if old.any():
             raise self._missing(np.flatnonzero(old), names, now)
         return self.q.copy(), self.qd.copy()

@@ -94,7 +94,10 @@ def test_partial_messages_alternate_and_expire(baxter):
     line = rejected('missing_joints', merger.merge, left, np.ones(7), [], [],
                     2.5)
     assert 'older than joint_states.hold (0.5 s): [' in line
-    assert "'head_pan (0.6 s ago)'" in line
+    # the left gripper (carried by the left arm) is needed; the head and
+    # the right arm (other branches) are not
+    assert "'l_gripper_l_finger_joint (0.6 s ago)'" in line
+    assert 'head_pan' not in line and 'right_' not in line
 
 
 def test_bad_messages_are_refused_with_the_joint_named(baxter):
@@ -216,3 +219,52 @@ def test_a_trajectory_of_one_arm_holds_the_others_where_they_are(baxter):
         np.testing.assert_allclose(efforts[k], expected, rtol=0,
                                    atol=1e-9 * (1 + np.abs(expected).max()))
     assert not exceeded
+
+
+TIAGO_PRO = 'tiago_pro_description/robots/tiago_pro.urdf'
+
+
+def test_only_the_joints_the_commanded_torques_depend_on_are_required():
+    """
+    The right arm of TIAGo Pro needs its torso and gripper only.
+
+    Its torques do not depend on the wheels, the head or the left arm,
+    and those need never be published.
+    """
+    from newton_euler_ros.whole_robot import needed_coordinates
+    model = robot(TIAGO_PRO)
+    names = list(model.joint_names)
+    arm = [j for j in names if j.startswith('arm_right')]
+    trigger = np.isin(names, arm)
+    needed = {names[k] for k in np.flatnonzero(
+        needed_coordinates(model, trigger))}
+    assert needed == set(arm) | {'torso_lift_joint',
+                                 'gripper_right_finger_joint'}
+    # the physics behind it: the right arm's torques are the same
+    # whatever the joints not needed do
+    rng = np.random.default_rng(4)
+    q, qd, qdd = rng.uniform(-1, 1, (3, model.n))
+    other = ~np.isin(names, sorted(needed))
+    q2, qd2, qdd2 = q.copy(), qd.copy(), qdd.copy()
+    for x in (q2, qd2, qdd2):
+        x[other] = rng.uniform(-1, 1, other.sum())
+    tau = inverse_dynamics(model, q, qd, qdd)
+    tau2 = inverse_dynamics(model, q2, qd2, qdd2)
+    np.testing.assert_allclose(tau2[trigger], tau[trigger], rtol=0,
+                               atol=1e-12 * np.abs(tau).max())
+    assert not np.allclose(tau2[other], tau[other])     # they did change
+    # the merger: states of the arm, torso and right gripper compute; the
+    # left gripper locked at 0.02; wheels, head and left arm never sent
+    merger = JointStateMerger(model, arm, hold=0.5, tolerance=0.005,
+                              locked={'gripper_left_finger_joint': 0.02})
+    sent = arm + ['torso_lift_joint', 'gripper_right_finger_joint']
+    got, _ = merger.merge(sent, np.full(len(sent), 0.1), [], [], 0.0)
+    assert got[names.index('gripper_left_finger_joint')] == 0.02
+    # a message moving the locked joint changes nothing
+    merger.merge(['gripper_left_finger_joint'], [0.5], [], [], 0.1)
+    got, _ = merger.merge(sent, np.full(len(sent), 0.1), [], [], 0.2)
+    assert got[names.index('gripper_left_finger_joint')] == 0.02
+    # a needed joint missing is still refused, by name
+    line = rejected('missing_joints', merger.merge, arm,
+                    np.zeros(len(arm)), [], [], 1.0)
+    assert 'torso_lift_joint' in line and 'wheel' not in line

@@ -596,3 +596,54 @@ def test_a_description_with_a_floating_root_gets_torques(tmp_path):
     log = node.log()
     assert ("'odom' carries the rest through the floating joint "
             "'odom_to_base': the model starts at 'base_footprint'") in log, log
+
+
+def test_one_arm_without_the_wheels_and_a_locked_gripper(tmp_path):
+    """
+    The right arm of TIAGo Pro commanded, the wheels never published.
+
+    Its states, the torso's and its gripper's arrive; the wheels, the
+    head and the left arm never do; the left gripper is locked.  The
+    torques come, and equal the library's at the locked position.
+    """
+    import time
+    from newton_euler_ros.core import inverse_dynamics
+    from newton_euler_tools.peers import example_robot_urdf
+    path = example_robot_urdf('tiago_pro_description/robots/tiago_pro.urdf')
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_urdf(path)
+    names = list(model.joint_names)
+    arm = [j for j in names if j.startswith('arm_right')]
+    sent = arm + ['torso_lift_joint', 'gripper_right_finger_joint']
+    domain = domain_id(29)
+    probe = Probe(domain)
+    node = NodeProcess(id_node_cmd(
+        None, '-p', f'robot_file:={path}',
+        '-p', f'joints:=[{", ".join(arm)}]',
+        '-p', 'joint_states.lock:=[gripper_left_finger_joint]',
+        '-p', 'joint_states.lock_positions:=[0.03]'),
+        domain, str(tmp_path / 'node.log'))
+    try:
+        commands = probe.collect(Float64MultiArray, f'{NODE}/torque_command')
+        states = probe.publisher(JointState, '/joint_states')
+        deadline = time.monotonic() + 90.0
+        k = 0
+        q = np.linspace(0.1, 0.4, len(sent))
+        while not commands:
+            assert node.alive() and time.monotonic() < deadline, node.log()
+            k += 1
+            states.publish(joint_state(sent, q.tolist(), [0.0] * len(sent),
+                                       probe.keyed_stamp(k)))
+            probe.spin_for(0.1)
+    finally:
+        assert node.stop() == 0, node.log()
+        probe.close()
+    full = np.zeros(model.n)
+    full[[names.index(j) for j in sent]] = q
+    full[names.index('gripper_left_finger_joint')] = 0.03
+    expected = inverse_dynamics(model, full, np.zeros(model.n))
+    np.testing.assert_allclose(
+        commands[-1].data, expected[[names.index(j) for j in arm]],
+        rtol=1e-12, atol=1e-12)
+    assert 'missing' not in node.log(), node.log()
