@@ -83,6 +83,7 @@ from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
                       VEC, vector, workspace, wrench_mode)
 from .frames import (end_effector_pose, frame_pose, jacobian, link_poses,
                      link_wrench_rows, wrench_torques)
+from .workspace import Workspace
 
 __all__ = [
     'CORIOLIS_METHODS', 'FORWARD_DYNAMICS_METHODS', 'MASS_MATRIX_METHODS',
@@ -186,12 +187,27 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
 
 
 def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
-    """Call the Newton-Euler entry again, its arguments converted once."""
-    ws = model.default_workspace if ws is None else workspace(model, ws)
+    """
+    Call the Newton-Euler entry again, its arguments converted once.
+
+    A given ``ws`` and ``out`` go in as they are (the entry refuses
+    another type, the kernel another size); only then are they checked
+    here, for the error that names them.
+    """
+    ws = model.default_workspace if ws is None else (
+        ws if type(ws) is Workspace and ws.n == model.n
+        and ws.nb == model.nb else workspace(model, ws))
     n = ws.n
     q, qd, qdd, wrench = inputs(ws, INPUTS, q, qd, qdd, wrench)
-    tau = np.empty(n) if out is None else out_array(out, (n,))
-    code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
+    tau = np.empty(n) if out is None else out
+    try:
+        code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
+    except Refused:
+        code = K.SIZE
+    if code >= K.SIZE:      # another dtype or size of ws or out: say which
+        workspace(model, ws)
+        tau = out_array(out, (n,))
+        code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
     if code >= 0:
         raise status_error(code, (q, qd, qdd, wrench))
     return tau

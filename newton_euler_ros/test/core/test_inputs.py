@@ -234,3 +234,20 @@ def test_lists_copied_into_the_workspace_never_alias_a_result():
 def test_bad_lists_name_the_argument(arm, call, message):
     with pytest.raises(DynamicsInputError, match=message):
         call(arm)
+
+
+def test_lists_with_a_wrong_ws_or_out_name_it(arm):
+    """The list path passes ws and out to the kernel unchecked, then says."""
+    from newton_euler_ros.core import Workspace
+    q = [0.1, 0.2]
+    with pytest.raises(DynamicsInputError, match='ws must be a float64'):
+        inverse_dynamics(arm, q, q, q, ws=Workspace(arm, np.float32))
+    with pytest.raises(DynamicsInputError, match='ws must be a float64'):
+        inverse_dynamics(arm, q, ws=Workspace(load_robot('puma560')))
+    for out in (np.empty(3), np.empty(2, np.float32), np.empty((2, 2))):
+        with pytest.raises(DynamicsInputError, match='out must be a '):
+            inverse_dynamics(arm, q, q, q, [0.0] * 6, out=out)
+    out = np.empty(2)
+    assert inverse_dynamics(arm, q, q, q, out=out) is out
+    assert np.array_equal(out, inverse_dynamics(arm, np.array(q),
+                                                np.array(q), np.array(q)))
