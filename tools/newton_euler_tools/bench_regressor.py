@@ -22,14 +22,13 @@ Pinocchio: a Python loop of ``pin.computeJointTorqueRegressor``, the way
 a user stacks it for identification, per state.  Both on the same
 published URDFs (example-robot-data).  Target: ours <= 0.5x Pinocchio.
 """
-import argparse
 import warnings
 
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.regressor import regressor_batch
 import numpy as np
 
-from .timing import min_time
+from .timing import min_time, quick_option
 
 TARGET = 0.5
 ROBOTS = (('panda', 'panda_description/urdf/panda.urdf', 'panda_hand_tcp'),
@@ -63,12 +62,8 @@ def measure(label, relative, tip, m, repeat):
 
 def main(argv=None):
     """Print the per-state table."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('--quick', action='store_true',
-                        help='fewer states and repeats (noisier)')
-    args = parser.parse_args(argv)
-    m, repeat = (500, 3) if args.quick else (5000, 7)
+    quick = quick_option(__doc__, 'fewer states and repeats (noisier)', argv)
+    m, repeat = (500, 3) if quick else (5000, 7)
     print(f'torque regressor per state, batch of {m}, best of {repeat} '
           f'(us); target ours <= {TARGET}x a Python loop of Pinocchio')
     print(f'{"robot":<8}{"n":>3}{"ours":>10}{"pinocchio":>12}{"ratio":>8}'

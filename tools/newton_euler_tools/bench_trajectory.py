@@ -23,25 +23,21 @@ CLI's ``feedforward`` and the node's ``~/trajectory_in`` path) on a
 from the positions, against a Python loop of single ``inverse_dynamics``
 calls over the same points, side by side in one run.
 """
-import argparse
 import warnings
 
 from newton_euler_ros.core import inverse_dynamics, load_robot
 from newton_euler_ros.core.trajectory import trajectory_efforts
 import numpy as np
 
-from .timing import min_time
+from .timing import min_time, quick_option
 
 POINTS = 1000
 
 
 def main(argv=None):
     """Print microseconds per trajectory point."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('--quick', action='store_true', help='fewer repeats')
-    args = parser.parse_args(argv)
-    repeat = 3 if args.quick else 15
+    quick = quick_option(__doc__, 'fewer repeats', argv)
+    repeat = 3 if quick else 15
     print(f'trajectory efforts, {POINTS} points, best of {repeat} '
           f'(us per point)')
     print(f'{"robot":<10}{"given qd, qdd":>16}{"derived":>12}'

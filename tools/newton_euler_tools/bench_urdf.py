@@ -24,7 +24,6 @@ general placement, not DH); and, when ``make peers`` installed
 Both kinds compile to the same kernel arrays, so the per-call cost should
 not depend on the source: the ratio column shows it.
 """
-import argparse
 import warnings
 
 from newton_euler_ros.core import (coriolis_matrix, gravity_torques,
@@ -33,6 +32,7 @@ from newton_euler_ros.core.urdf import load_urdf, model_to_urdf
 import numpy as np
 
 from .bench_effects import _min_time
+from .timing import quick_option
 
 PUBLISHED = (('ur5 (URDF)', 'ur_description/urdf/ur5_robot.urdf', 'tool0'),
              ('panda (URDF)', 'panda_description/urdf/panda.urdf',
@@ -58,12 +58,8 @@ def robots():
 
 def main(argv=None):
     """Print the per-call table."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('--quick', action='store_true',
-                        help='fewer repeats (noisier)')
-    args = parser.parse_args(argv)
-    number, repeat = (2000, 3) if args.quick else (20000, 7)
+    quick = quick_option(__doc__, 'fewer repeats (noisier)', argv)
+    number, repeat = (2000, 3) if quick else (20000, 7)
     rng = np.random.default_rng(0)
     rows = []
     for label, model in robots():

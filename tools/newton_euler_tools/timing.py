@@ -12,7 +12,8 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The best-of-R wall time the small benchmarks share."""
+"""The best-of-R wall time and the command line the small benchmarks share."""
+import argparse
 import time
 
 
@@ -32,3 +33,15 @@ def min_time(fn, number=1, repeat=5):
             fn()
         best = min(best, (time.perf_counter() - start) / number)
     return best
+
+
+def quick_option(doc, what, argv=None):
+    """
+    Return whether ``--quick`` is given: a small benchmark's only option.
+
+    The command line's description is the first line of ``doc`` (the
+    module's docstring); ``what`` is ``--quick``'s help: what it cuts.
+    """
+    parser = argparse.ArgumentParser(description=doc.strip().split('\n')[0])
+    parser.add_argument('--quick', action='store_true', help=what)
+    return parser.parse_args(argv).quick
