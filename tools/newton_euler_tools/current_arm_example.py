@@ -79,7 +79,6 @@ Python API (kept stable for the tests that use it):
   signals at the messages (torque, friction, external torque);
 - :func:`make_example` (out_dir, ...): every file above; returns paths.
 """
-import argparse
 import math
 import os
 import shutil
@@ -416,9 +415,8 @@ def make_example(out_dir, seed=0, effort='current', seconds=60.0,
 
 def main(argv=None):
     """Write the example files."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('out_dir')
+    from .ident_example import example_parser
+    parser = example_parser(__doc__)
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--effort', choices=('current', 'torque'),
                         default='current')

@@ -66,7 +66,6 @@ Files in OUT_DIR: ``ROBOT.urdf`` (nominal), the rosbag2 (MCAP)
 recordings above, and ``truth.json`` (the perturbed URDF, the drives, the
 constants and payloads; for checking, not used by the commands).
 """
-import argparse
 import math
 import os
 import shutil
@@ -419,9 +418,8 @@ def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
 
 def main(argv=None):
     """Write the example files."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('out_dir')
+    from .ident_example import example_parser
+    parser = example_parser(__doc__)
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--seconds', type=float, default=60.0)
     parser.add_argument('--rate', type=float, default=100.0)

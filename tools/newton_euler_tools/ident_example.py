@@ -273,11 +273,16 @@ def write_truth(out_dir, truth):
     return path
 
 
+def example_parser(doc):
+    """Return an example writer's parser: ``doc``'s first line, ``out_dir``."""
+    parser = argparse.ArgumentParser(description=doc.strip().split('\n')[0])
+    parser.add_argument('out_dir')
+    return parser
+
+
 def main(argv=None):
     """Write the example files."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('out_dir')
+    parser = example_parser(__doc__)
     parser.add_argument('--seconds', type=float, default=40.0)
     parser.add_argument('--rate', type=float, default=500.0)
     parser.add_argument('--seed', type=int, default=0)

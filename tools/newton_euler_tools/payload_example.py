@@ -29,7 +29,6 @@ Writes into OUT_DIR:
     python -m newton_euler_tools.payload_example OUT_DIR [--mass KG]
            [--com X Y Z] [--seconds S] [--seed N] [--only-base]
 """
-import argparse
 import json
 import os
 import shutil
@@ -37,8 +36,9 @@ import warnings
 
 import numpy as np
 
-from .ident_example import (BASE, EXTRA, fourier_trajectory,
-                            measured_efforts, panda_path, random_drives, TIP)
+from .ident_example import (BASE, example_parser, EXTRA,
+                            fourier_trajectory, measured_efforts,
+                            panda_path, random_drives, TIP)
 
 MASS = 1.5
 COM = (0.01, -0.02, 0.06)
@@ -132,9 +132,7 @@ def make_example(out_dir, mass=MASS, com=COM, inertia_c=INERTIA_C,
 
 def main(argv=None):
     """Write the example files."""
-    parser = argparse.ArgumentParser(description=__doc__.strip().split(
-        '\n')[0])
-    parser.add_argument('out_dir')
+    parser = example_parser(__doc__)
     parser.add_argument('--mass', type=float, default=MASS)
     parser.add_argument('--com', type=float, nargs=3, default=COM)
     parser.add_argument('--seconds', type=float, default=30.0)
