@@ -336,11 +336,8 @@ def record(arm, path, motion, rate=100.0, effort='current', payload=None,
     stamps = 1_700_000_000 * 10**9 + np.round(t * 1e9).astype(np.int64)
     rows = [qm, qdm, measured]
     if twice.size:
-        order = np.argsort(np.concatenate([np.arange(len(t)), twice + 0.5]),
-                           kind='stable')
-        later = stamps[twice] + (stamps[twice + 1] - stamps[twice]) // 2
-        stamps = np.concatenate([stamps, later])[order]
-        rows = [np.concatenate([r, r[twice]])[order] for r in rows]
+        from .ident_example import repeat_messages
+        stamps, rows = repeat_messages(stamps, rows, twice)
     perm = [JOINTS.index(x) for x in DRIVER_ORDER]
     if os.path.exists(path):
         shutil.rmtree(path)

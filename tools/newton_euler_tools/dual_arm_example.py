@@ -368,11 +368,8 @@ def record(model, truth, drives, path, f, rate=100.0, payload=None,
             for j, s, o in cols]))
     stamps = 1_700_000_000 * 10**9 + np.round(t * 1e9).astype(np.int64)
     if twice.size:
-        order = np.argsort(np.concatenate([np.arange(len(t)), twice + 0.5]),
-                           kind='stable')
-        later = stamps[twice] + (stamps[twice + 1] - stamps[twice]) // 2
-        stamps = np.concatenate([stamps, later])[order]
-        rows = [np.concatenate([r, r[twice]])[order] for r in rows]
+        from .ident_example import repeat_messages
+        stamps, rows = repeat_messages(stamps, rows, twice)
     if os.path.exists(path):
         shutil.rmtree(path)
     write_joint_states(path, stamps, names, *rows)

@@ -201,11 +201,7 @@ def simulate(truth_urdf_path, model, drives, trajectory, seconds, rate,
     # repeated messages: the same values, stamped a little later
     rep = np.flatnonzero(rng.random(len(idx) - 1) < repeated)
     if rep.size:
-        order = np.argsort(np.concatenate([np.arange(len(idx)), rep + 0.5]),
-                           kind='stable')
-        later = stamps[rep] + (stamps[rep + 1] - stamps[rep]) // 2
-        stamps = np.concatenate([stamps, later])[order]
-        rows = [np.concatenate([r, r[rep]])[order] for r in rows]
+        stamps, rows = repeat_messages(stamps, rows, rep)
     # the message lists the fingers too, and in another order
     names = list(reversed(model.joint_names)) + list(EXTRA)
     perm = [model.joint_names.index(x) for x in reversed(model.joint_names)]
@@ -257,6 +253,19 @@ def make_example(out_dir, seconds=40.0, rate=500.0, seed=0,
         'urdf': truth_text, 'base': BASE, 'tip': TIP,
         'drives': jsonable(drives)})
     return paths
+
+
+def repeat_messages(stamps, rows, again):
+    """
+    Return ``stamps`` and ``rows`` with the messages ``again`` sent twice.
+
+    A repeat carries the same values, stamped halfway to the next message.
+    """
+    order = np.argsort(np.concatenate([np.arange(len(stamps)), again + 0.5]),
+                       kind='stable')
+    later = stamps[again] + (stamps[again + 1] - stamps[again]) // 2
+    return (np.concatenate([stamps, later])[order],
+            [np.concatenate([r, r[again]])[order] for r in rows])
 
 
 def jsonable(values):
