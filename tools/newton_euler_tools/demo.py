@@ -91,6 +91,19 @@ def base_domain(count=2):
     return first_domain(1 + os.getpid() % 100, count)
 
 
+def start_runs(out):
+    """
+    Make the folder ``out`` and its logs; pick the two runs' first domain.
+
+    Return the absolute ``out``, its ``logs`` folder and the first domain
+    id (:func:`base_domain`: ValueError for an unusable ROS_DOMAIN_ID).
+    """
+    out = os.path.abspath(out)
+    log_dir = os.path.join(out, 'logs')
+    os.makedirs(log_dir, exist_ok=True)
+    return out, log_dir, base_domain()
+
+
 class Child(ChildProcess):
     """A node run as ``python -m module --ros-args ...``."""
 
@@ -376,11 +389,8 @@ def main(argv=None):
     duration = args.duration or (QUICK_DURATION if args.quick
                                  else scene.duration)
     duration = min(duration, scene.duration)
-    out = os.path.abspath(args.out)
-    log_dir = os.path.join(out, 'logs')
-    os.makedirs(log_dir, exist_ok=True)
     try:
-        base = base_domain()
+        out, log_dir, base = start_runs(args.out)
     except ValueError as exc:
         print(f'demo: {exc}', file=sys.stderr)
         return 2

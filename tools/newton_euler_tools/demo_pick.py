@@ -43,7 +43,7 @@ import warnings
 from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import (base_domain, check_exits, Child, DemoError, Recorder,
+from .demo import (check_exits, Child, DemoError, Recorder, start_runs,
                    STARTUP_TIMEOUT, stop_children, wait_for)
 
 SCENE = 'puma_pick_and_place'
@@ -288,11 +288,8 @@ def main(argv=None):
         scene = load_scene(SCENE)
         model = load_robot('puma560')
     duration = PICK + 0.8 if args.quick else CARRY + HOLD + MOVE + 0.5
-    out = os.path.abspath(args.out)
-    log_dir = os.path.join(out, 'logs')
-    os.makedirs(log_dir, exist_ok=True)
     try:
-        base = base_domain()
+        out, log_dir, base = start_runs(args.out)
     except ValueError as exc:
         print(f'demo_pick: {exc}', file=sys.stderr)
         return 2
