@@ -14,11 +14,11 @@
 
 
 """The folder tree is the architecture: core, then sim, then ROS."""
-import ast
 import os
 import subprocess
 import sys
 
+import import_graph as ig
 import pytest
 
 ROS_MODULES = ('rclpy', 'rcl_interfaces', 'sensor_msgs', 'geometry_msgs',
@@ -49,48 +49,8 @@ print(sorted(m for m in sys.modules
 
 PACKAGE = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
     os.path.abspath(__file__)))), 'newton_euler_ros')
-CORE = os.path.join(PACKAGE, 'core')
 # per module of core/ and of the ROS adapters (docs/how-it-is-computed.md)
 MAX_LINES = 600
-
-
-def _core_modules():
-    """{dotted name: path} of every module under core/."""
-    out = {}
-    for folder, _, files in os.walk(CORE):
-        for name in files:
-            if name.endswith('.py'):
-                path = os.path.join(folder, name)
-                rel = os.path.relpath(path, os.path.dirname(CORE))
-                dotted = 'newton_euler_ros.' + rel[:-3].replace(os.sep, '.')
-                out[dotted.removesuffix('.__init__')] = path
-    return out
-
-
-def _imports(dotted, path, modules):
-    """Core modules imported anywhere in a module (in functions too)."""
-    is_package = path.endswith('__init__.py')
-    package = dotted if is_package else dotted.rsplit('.', 1)[0]
-    with open(path, encoding='utf-8') as fh:
-        tree = ast.parse(fh.read(), path)
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            targets = [a.name for a in node.names]
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.rsplit('.', node.level - 1)[0] \
-                    if node.level > 1 else package
-                base = f'{base}.{node.module}' if node.module else base
-            else:
-                base = node.module or ''
-            # "from X import Y" imports X.Y when that is a module, else X
-            targets = [f'{base}.{a.name}' if f'{base}.{a.name}' in modules
-                       else base for a in node.names]
-        else:
-            continue
-        found.update(t for t in targets if t in modules and t != dotted)
-    return found
 
 
 def _long(paths):
@@ -116,7 +76,7 @@ def _adapter_modules():
 
 
 def test_core_modules_are_short():
-    long = _long(_core_modules().values())
+    long = _long(ig.modules('core').values())
     assert not long, f'core modules over {MAX_LINES} lines: {long}'
 
 
@@ -150,37 +110,3 @@ def test_the_size_check_sees_a_long_module(tmp_path):
     short.write_text('x = 1\n' * MAX_LINES)
     long.write_text('x = 1\n' * (MAX_LINES + 1))
     assert _long([str(short), str(long)]) == {str(long): MAX_LINES + 1}
-
-
-def test_core_has_no_import_cycle():
-    modules = _core_modules()
-    graph = {m: _imports(m, p, modules) for m, p in modules.items()}
-    # a package's own __init__ imports its modules; the reverse edge (a
-    # module importing its package) is the cycle to catch
-    state = {}
-
-    def visit(m, stack):
-        state[m] = 'open'
-        for t in sorted(graph[m]):
-            if state.get(t) == 'open':
-                cycle = stack[stack.index(t):] + [t]
-                pytest.fail('import cycle in core: ' + ' -> '.join(cycle))
-            if t not in state:
-                visit(t, stack + [t])
-        state[m] = 'done'
-
-    for m in sorted(graph):
-        if m not in state:
-            visit(m, [m])
-
-
-def test_the_cycle_check_sees_a_cycle(tmp_path):
-    """The old robot_file <-> urdf circle (imports inside functions)."""
-    mods = {'newton_euler_ros.core.a': tmp_path / 'a.py',
-            'newton_euler_ros.core.b': tmp_path / 'b.py'}
-    mods['newton_euler_ros.core.a'].write_text(
-        'def f():\n    from .b import g\n')
-    mods['newton_euler_ros.core.b'].write_text('from .a import f\n')
-    graph = {m: _imports(m, str(p), mods) for m, p in mods.items()}
-    assert graph == {'newton_euler_ros.core.a': {'newton_euler_ros.core.b'},
-                     'newton_euler_ros.core.b': {'newton_euler_ros.core.a'}}
