@@ -333,7 +333,7 @@ def cmd_identify(args):
                       '--known-mass-link')
     from .ident.fit import fixed_parts
     from .ident.problem import REST_FRACTION, REST_SPEED, rest_speeds
-    from .ident.notes import far_masses, torque_like
+    from .ident.notes import report
     from .ident.urdf_out import atomic_write, identified_urdf
     result = _identify_or_fail(model, text, args)
     names = model.joint_names
@@ -391,9 +391,9 @@ def cmd_identify(args):
         atomic_write(out, body)
     except OSError as exc:
         _fail(f'{args.output}: cannot write: {exc.strerror or exc}')
-    for line in (result.notes + far_masses(model, result)
-                 + torque_like(result)):
-        print(f'note: {line}', file=sys.stderr)
+    for kind, line in report(model, result, args.known_mass, args.validate,
+                             args.topic):
+        print(f'{kind}: {line}', file=sys.stderr)
     if worse:
         print(f'warning: the identified model does WORSE than the nominal on '
               f'{_listed(worse)}: check the recording (excitation, effort '
