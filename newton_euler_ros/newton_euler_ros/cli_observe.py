@@ -203,6 +203,7 @@ def _observe(args):
         args.bag, model, rec.stamps, rec.q, rec.qd, rec.effort, args.robot,
         units.URDF_FIX + '; the external torques and contacts below are '
         'meaningless')
+    unit = unit or _rest_units(args, model, rec)
     if unit:
         print(f'warning: {unit}', file=sys.stderr)
     names = list(model.joint_names)
@@ -219,6 +220,44 @@ def _observe(args):
     if wrote:
         print('wrote ' + ' and '.join(wrote))
     return 0
+
+
+def _rest_units(args, model, rec):
+    """
+    Check the units where the arm holds still: g(q) against the effort.
+
+    The one line of ``core.effort_units.describe``, or None; for a
+    recording of held poses, where the check on motion cannot tell.
+    """
+    from .core.batch import gravity_torques_batch
+    from .core.drives import model_drives
+    from .core.effort_units import describe, rest_ratios, URDF_FIX
+    drives = model_drives(model)
+    given = drives is not None and drives.torque_constant is not None
+    meas = drives.effort_to_torque(rec.effort) if given else rec.effort
+    K, counts = rest_ratios(rec.qd, gravity_torques_batch(model, rec.q),
+                            meas)
+    return describe(f'{args.bag} (where the arm holds still: gravity torque '
+                    f'g(q) against the effort)', model.joint_names, K,
+                    counts.astype(float), 'given' if given else 'torque',
+                    args.robot, URDF_FIX + '; the external torques and '
+                    'contacts below are meaningless')
+
+
+def _motionless(args, rec):
+    """Return the note on a recording where no joint moves, or []."""
+    moving = float(np.mean(np.any(np.abs(rec.qd) > MOVING, axis=1)))
+    if moving >= HELD:
+        return []
+    return [f'{args.bag}: no joint moves faster than {MOVING:g} rad/s in '
+            f'{1 - moving:.1%} of the samples (held poses): the suggested '
+            f"thresholds bound only the noise at rest, not the model's "
+            f'error while moving; suggest them from a free recording with '
+            f'motion (an excitation)']
+
+
+MOVING = 0.05       # rad/s (m/s): a joint moves faster than this
+HELD = 0.01         # a recording moving in fewer samples holds still
 
 
 def _write_csv(fh, rec, out, names):
@@ -270,7 +309,7 @@ def _summary(args, model, obs, rec, out):
                                      if resting.any() else None),
         'contact_intervals': _intervals(t, out.contact),
         'csv': args.csv, 'plot': args.plot,
-        'notes': list(getattr(rec, 'notes', []))}
+        'notes': list(getattr(rec, 'notes', [])) + _motionless(args, rec)}
 
 
 def _table(s):

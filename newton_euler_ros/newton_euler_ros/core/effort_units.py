@@ -112,6 +112,38 @@ def describe(label, names, K, explained, mode, urdf=None, fix=CURRENT_FIX):
             f'near 1 for torques); {fix}')
 
 
+#: a held arm: every joint slower than this (rad/s)
+HELD_SPEED = 0.02
+#: at rest a joint counts when its gravity torque is at least this fraction
+#: of the largest joint's (static friction holds up to a few N m anywhere)
+REST_GRAVITY = 0.25
+
+
+def rest_ratios(qd, gravity, effort):
+    """
+    Per joint (K, counts): gravity torque / effort where the arm holds still.
+
+    ``qd`` speeds, ``gravity`` the model's g(q) (N m) and ``effort`` (in
+    the unit the model says) at the samples.  A held arm's effort is g(q)
+    plus what static friction holds (within +-F_s, any sign): the effort
+    regressed on g, e = g / K, gives K about 1 for torques and about the
+    torque constant for currents, on the joints that gravity loads
+    (``REST_GRAVITY``).  What the test on motion
+    (:func:`sample_ratios`) cannot tell from a recording of held poses:
+    there the offset column takes it all.  Counts nothing without a
+    sample at rest.
+    """
+    n = gravity.shape[1]
+    held = np.all(np.abs(qd) < HELD_SPEED, axis=1)
+    g, e = gravity[held], effort[held]
+    gg, ge = (g * g).sum(axis=0), (g * e).sum(axis=0)
+    size = np.sqrt(gg / max(int(held.sum()), 1))
+    counts = (size > 0) & (size >= REST_GRAVITY * size.max(initial=0.0))
+    counts &= ge != 0
+    K = np.where(counts, gg / np.where(ge != 0, ge, 1.0), 0.0)
+    return K, counts if held.any() else np.zeros(n, dtype=bool)
+
+
 class EffortMonitor:
     """
     The test of :func:`describe` on a live stream, window after window.
