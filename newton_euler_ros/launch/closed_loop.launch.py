@@ -24,11 +24,16 @@ commands PD plus that feedforward.  The nodes use relative or private
 names; the controller's remaps come from ``newton_euler_ros.graph``
 (the demo, ``python -m newton_euler_tools.demo``, uses the same).
 """
+import os
+import sys
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
 from newton_euler_ros.graph import CONTROLLER_REMAPS
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from newton_euler_launch_parts import package_node  # noqa: E402, I100
 
 
 def generate_launch_description():
@@ -39,27 +44,18 @@ def generate_launch_description():
                                           'file'),
         DeclareLaunchArgument('feedforward', default_value='true',
                               description='false: PD alone'),
-        Node(
-            package='newton_euler_ros',
-            executable='robot_sim_node',
-            name='robot_sim_node',
-            output='screen',
+        package_node(
+            'robot_sim_node',
             # the controller and the inverse-dynamics node
             parameters=[{'scene': scene, 'wait_for_subscribers': 2}],
         ),
-        Node(
-            package='newton_euler_ros',
-            executable='inverse_dynamics_node',
-            name='inverse_dynamics_node',
-            output='screen',
+        package_node(
+            'inverse_dynamics_node',
             parameters=[{'scene': scene,
                          'acceleration_source': 'reference'}],
         ),
-        Node(
-            package='newton_euler_ros',
-            executable='tracking_controller_node',
-            name='tracking_controller_node',
-            output='screen',
+        package_node(
+            'tracking_controller_node',
             parameters=[{'scene': scene,
                          'feedforward': LaunchConfiguration('feedforward')}],
             remappings=list(CONTROLLER_REMAPS),

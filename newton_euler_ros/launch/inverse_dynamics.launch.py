@@ -22,35 +22,31 @@ e.g. ``ros2 launch ... joint_states:=/my_robot/joint_states
 torque_command:=/effort_controller/commands``.
 """
 import os
+import sys
 
-from ament_index_python.packages import get_package_share_directory
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration, PythonExpression
-from launch_ros.actions import Node
 from newton_euler_ros.graph import INVERSE_DYNAMICS_TOPICS
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from newton_euler_launch_parts import (  # noqa: E402, I100
+    package_node, params_path, topic_arguments)
 
 
 def generate_launch_description():
-    share = get_package_share_directory('newton_euler_ros')
     robot = LaunchConfiguration('robot')
     params = PythonExpression([
-        "'", os.path.join(share, 'config', 'params', ''), "' + '", robot,
-        "' + '.yaml'"])
+        "'", params_path(''), "' + '", robot, "' + '.yaml'"])
     return LaunchDescription([
         DeclareLaunchArgument('robot', default_value='puma560',
                               description='bundled robot whose parameter '
                                           'file to load'),
         DeclareLaunchArgument('params_file', default_value=params,
                               description='parameter file (overrides robot)'),
-        *(DeclareLaunchArgument(arg, default_value=default,
-                                description=text)
-          for _, arg, default, text in INVERSE_DYNAMICS_TOPICS),
-        Node(
-            package='newton_euler_ros',
-            executable='inverse_dynamics_node',
-            name='inverse_dynamics_node',
-            output='screen',
+        *topic_arguments(INVERSE_DYNAMICS_TOPICS),
+        package_node(
+            'inverse_dynamics_node',
             parameters=[LaunchConfiguration('params_file')],
             remappings=[(name, LaunchConfiguration(arg))
                         for name, arg, _, _ in INVERSE_DYNAMICS_TOPICS],

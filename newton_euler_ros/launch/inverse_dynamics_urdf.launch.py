@@ -25,40 +25,23 @@ is written by hand.  Remap ``robot_description``, ``joint_states``,
 ``torque_command:=/effort_controller/commands``.
 """
 import os
+import sys
 
-from ament_index_python.packages import get_package_share_directory
-from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
 from newton_euler_ros.graph import URDF_TOPICS
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from newton_euler_launch_parts import urdf_description  # noqa: E402, I100
 
 
 def generate_launch_description():
-    share = get_package_share_directory('newton_euler_ros')
     arg = LaunchConfiguration
-    return LaunchDescription([
-        DeclareLaunchArgument('base_link', default_value='base_link',
-                              description='first link of the chain'),
-        DeclareLaunchArgument('tip_link', default_value='tool0',
-                              description='last link: the end effector'),
-        DeclareLaunchArgument(
-            'params_file',
-            default_value=os.path.join(share, 'config', 'params',
-                                       'urdf.yaml'),
-            description='parameter file (wrench frames, QoS, ...)'),
-        *(DeclareLaunchArgument(name, default_value=default,
-                                description=text)
-          for _, name, default, text in URDF_TOPICS),
-        Node(
-            package='newton_euler_ros',
-            executable='inverse_dynamics_node',
-            name='inverse_dynamics_node',
-            output='screen',
-            parameters=[arg('params_file'),
-                        {'base_link': arg('base_link'),
-                         'tip_link': arg('tip_link')}],
-            remappings=[(topic, arg(name))
-                        for topic, name, _, _ in URDF_TOPICS],
-        ),
-    ])
+    tip = DeclareLaunchArgument('tip_link', default_value='tool0',
+                                description='last link: the end effector')
+    return urdf_description(
+        'first link of the chain', [tip],
+        ('urdf.yaml', 'parameter file (wrench frames, QoS, ...)'),
+        {'base_link': arg('base_link'), 'tip_link': arg('tip_link')},
+        remappings=[(topic, arg(name))
+                    for topic, name, _, _ in URDF_TOPICS])

@@ -26,10 +26,15 @@ Doubles need a decimal point (``real_time_factor:=2.0``); docs/node.md
 lists every parameter (run the node without ``robot_file`` to simulate
 robot_state_publisher's ``robot_description``).
 """
+import os
+import sys
+
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from newton_euler_launch_parts import package_node  # noqa: E402, I100
 
 ARGUMENTS = (
     ('robot_file', 'panda', 'URDF or MJCF file, robot YAML file or bundled '
@@ -52,11 +57,8 @@ def generate_launch_description():
         DeclareLaunchArgument(
             'commands', default_value='/effort_controller/commands',
             description='topic of the effort commands'),
-        Node(
-            package='newton_euler_ros',
-            executable='mujoco_sim_node',
-            name='mujoco_sim_node',
-            output='screen',
+        package_node(
+            'mujoco_sim_node',
             parameters=[{name: arg(name) for name, _, _ in ARGUMENTS}],
             remappings=[('effort_controller/commands', arg('commands'))],
         ),

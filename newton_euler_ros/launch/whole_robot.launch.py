@@ -30,41 +30,22 @@ command as your graph needs, e.g.
 ``torque_command:=/effort_controller/commands``.
 """
 import os
+import sys
 
-from ament_index_python.packages import get_package_share_directory
-from launch import LaunchDescription
-from launch.actions import DeclareLaunchArgument
 from launch.substitutions import LaunchConfiguration
-from launch_ros.actions import Node
 from newton_euler_ros.graph import URDF_TOPICS
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from newton_euler_launch_parts import urdf_description  # noqa: E402, I100
 
 
 def generate_launch_description():
-    share = get_package_share_directory('newton_euler_ros')
     arg = LaunchConfiguration
-    return LaunchDescription([
-        DeclareLaunchArgument('base_link', default_value='base_link',
-                              description='base link of the robot: the '
-                                          'whole tree below it is served'),
-        DeclareLaunchArgument(
-            'params_file',
-            default_value=os.path.join(share, 'config', 'params',
-                                       'whole_robot.yaml'),
-            description='parameter file (commanded joints, wrench '
-                        'sensors, observer end effectors, QoS, ...)'),
-        *(DeclareLaunchArgument(name, default_value=default,
-                                description=text)
-          for _, name, default, text in URDF_TOPICS),
-        Node(
-            package='newton_euler_ros',
-            executable='inverse_dynamics_node',
-            name='inverse_dynamics_node',
-            output='screen',
-            # no tip link: the whole robot, whatever the file says
-            parameters=[arg('params_file'),
-                        {'robot_file': '', 'base_link': arg('base_link'),
-                         'tip_link': ''}],
-            remappings=[(topic, arg(name))
-                        for topic, name, _, _ in URDF_TOPICS],
-        ),
-    ])
+    return urdf_description(
+        'base link of the robot: the whole tree below it is served', [],
+        ('whole_robot.yaml', 'parameter file (commanded joints, wrench '
+                             'sensors, observer end effectors, QoS, ...)'),
+        # no tip link: the whole robot, whatever the file says
+        {'robot_file': '', 'base_link': arg('base_link'), 'tip_link': ''},
+        remappings=[(topic, arg(name))
+                    for topic, name, _, _ in URDF_TOPICS])
