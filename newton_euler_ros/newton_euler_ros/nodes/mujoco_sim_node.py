@@ -90,7 +90,7 @@ from std_msgs.msg import Float64MultiArray, Header, String
 
 from .common import (ConfigurationError, declare_parameters, qos_profile,
                      QUIET, release_memory, run_node, SharedGraphNode)
-from .robot_sim_node import FRAME_IDS
+from .robot_sim_node import FRAME_IDS, publish_wrench
 from ..core import NewtonEulerError
 from ..core.text import clip
 from ..parameters import load_specs
@@ -378,12 +378,8 @@ class MujocoSimNode(SharedGraphNode):
         self._clock_msg.clock = now
         self.clock_pub.publish(self._clock_msg)
         if self.wrench_pub is not None:     # first: the torques need it
-            w = self.scene.wrench.at(plant.time)
-            m = self._scene_wrench
-            m.header.stamp = now
-            f, n = m.wrench.force, m.wrench.torque
-            f.x, f.y, f.z, n.x, n.y, n.z = (float(x) for x in w)
-            self.wrench_pub.publish(m)
+            publish_wrench(self.wrench_pub, self._scene_wrench, now,
+                           self.scene.wrench.at(plant.time))
         q, qd = plant.state()
         effort = self._zero if plant.held else plant.applied()
         msg = self._state
@@ -406,15 +402,10 @@ class MujocoSimNode(SharedGraphNode):
         zero = np.zeros(6)
         gone = self.in_contact - set(wrenches)
         self.in_contact = set(wrenches)
-        m = self._wrench
-        m.header.stamp = now
-        f, n = m.wrench.force, m.wrench.torque
         for link, w in [*wrenches.items(), *((g, zero) for g in gone)]:
             pub = self._contact_pub(link)
-            if pub is None:
-                continue
-            f.x, f.y, f.z, n.x, n.y, n.z = (float(x) for x in w)
-            pub.publish(m)
+            if pub is not None:
+                publish_wrench(pub, self._wrench, now, w)
 
     # ---- diagnostics ----
     def _on_diagnostics(self):

@@ -107,6 +107,14 @@ def advance(dyn, q, qd, tau, t, period, dt, method, wrench_at=None):
     return q, qd
 
 
+def publish_wrench(pub, msg, stamp, w):
+    """Publish the WrenchStamped ``msg`` stamped ``stamp``, holding ``w``."""
+    msg.header.stamp = stamp
+    f, n = msg.wrench.force, msg.wrench.torque
+    f.x, f.y, f.z, n.x, n.y, n.z = (float(x) for x in w)
+    pub.publish(msg)
+
+
 class RobotSimNode(SharedGraphNode):
     """Simulate a scene; torques in on ~/commands, joint states out."""
 
@@ -411,12 +419,8 @@ class RobotSimNode(SharedGraphNode):
     def _publish_wrench(self, stamp):
         if self.wrench_pub is None:
             return
-        w = self.scene.wrench.at(self.t)
-        m = self._wrench
-        m.header.stamp = stamp
-        f, tq = m.wrench.force, m.wrench.torque
-        f.x, f.y, f.z, tq.x, tq.y, tq.z = (float(x) for x in w)
-        self.wrench_pub.publish(m)
+        publish_wrench(self.wrench_pub, self._wrench, stamp,
+                       self.scene.wrench.at(self.t))
 
     def destroy_node(self):
         """Log how many commands the plant received, then destroy."""
