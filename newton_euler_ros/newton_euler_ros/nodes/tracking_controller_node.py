@@ -71,6 +71,13 @@ def _key(stamp):
     return (stamp.sec, stamp.nanosec)
 
 
+def _keep(pending, key, value):
+    """Keep ``value`` for matching by stamp; the oldest beyond PENDING go."""
+    pending[key] = value
+    while len(pending) > PENDING:
+        pending.popitem(last=False)
+
+
 def reference_message(scene, names, t0_stamp, sample=SAMPLE):
     """Return the scene's reference as a JointTrajectory starting at t0."""
     msg = JointTrajectory()
@@ -162,18 +169,23 @@ class TrackingControllerNode(SharedGraphNode):
                 'command subscribers); subscribed to joint_states')
         self._publish_reference()
 
-    def _gather(self, names, values, what):
-        """Return ``values`` in the model's joint order."""
-        names = tuple(names)
-        if names == tuple(self.names) or not names:
-            if len(values) != self.n:
+    def _gather(self, msg, *fields):
+        """Return the JointState's ``fields`` in the model's joint order."""
+        names = tuple(msg.name)
+        idx = None
+        if names != tuple(self.names) and names:
+            idx = self._index.get(names)
+            if idx is None:
+                idx = [names.index(j) for j in self.names]
+                self._index[names] = idx
+        arrays = []
+        for what in fields:
+            values = getattr(msg, what)
+            if idx is None and len(values) != self.n:
                 raise ValueError(f'{what}: expected {self.n} values')
-            return np.asarray(values, dtype=float)
-        idx = self._index.get(names)
-        if idx is None:
-            idx = [names.index(j) for j in self.names]
-            self._index[names] = idx
-        return np.asarray(values, dtype=float)[idx]
+            values = np.asarray(values, dtype=float)
+            arrays.append(values if idx is None else values[idx])
+        return arrays
 
     def _on_start(self, msg):
         t0 = seconds(msg.stamp)
@@ -209,8 +221,7 @@ class TrackingControllerNode(SharedGraphNode):
         if self.t0 is None:
             return
         try:
-            q = self._gather(msg.name, msg.position, 'position')
-            qd = self._gather(msg.name, msg.velocity, 'velocity')
+            q, qd = self._gather(msg, 'position', 'velocity')
         except (ValueError, IndexError) as exc:
             self.get_logger().warning(f'dropped joint state: {exc}',
                                       throttle_duration_sec=2.0)
@@ -224,13 +235,11 @@ class TrackingControllerNode(SharedGraphNode):
         if ff is not None:
             self._command(t, q, qd, ff)
             return
-        self.states[key] = (t, q, qd)
-        while len(self.states) > PENDING:
-            self.states.popitem(last=False)
+        _keep(self.states, key, (t, q, qd))
 
     def _on_ff(self, msg):
         try:
-            ff = self._gather(msg.name, msg.effort, 'effort')
+            ff, = self._gather(msg, 'effort')
         except (ValueError, IndexError) as exc:
             self.get_logger().warning(f'dropped feedforward: {exc}',
                                       throttle_duration_sec=2.0)
@@ -238,9 +247,7 @@ class TrackingControllerNode(SharedGraphNode):
         key = _key(msg.header.stamp)
         state = self.states.pop(key, None)
         if state is None:
-            self.ffs[key] = ff
-            while len(self.ffs) > PENDING:
-                self.ffs.popitem(last=False)
+            _keep(self.ffs, key, ff)
             return
         # states older than this one will not be answered any more
         for old in [k for k in self.states if k < key]:
