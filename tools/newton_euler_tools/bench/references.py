@@ -197,13 +197,36 @@ def _fmt_diffs(diffs, ok):
                      for k, v in diffs.items())
 
 
-def _setup_pinocchio(model, states, ref, result, log):
+def _peer(key, label, load, result, log):
+    """
+    Return ``load()``, a peer's module, or None when it does not import.
+
+    None is logged under ``label`` and marks the peer (``key``) neither
+    valid nor invalid in ``result``.
+    """
     try:
-        import pinocchio as pin
+        return load()
     except Exception as exc:
-        log(f'  Pinocchio   : not importable ({type(exc).__name__}: {exc}); '
+        log(f'  {label:<12}: not importable ({type(exc).__name__}: {exc}); '
             f'skipped')
-        result['valid']['pin'] = None
+        result['valid'][key] = None
+        return None
+
+
+def _import_pinocchio():
+    import pinocchio
+    return pinocchio
+
+
+def _import_rtb():
+    import roboticstoolbox  # noqa: F401
+    from roboticstoolbox.robot import frne
+    return frne
+
+
+def _setup_pinocchio(model, states, ref, result, log):
+    pin = _peer('pin', 'Pinocchio', _import_pinocchio, result, log)
+    if pin is None:
         return None
     pm = peers.pinocchio_model(model)
     pd = pm.createData()
@@ -247,13 +270,8 @@ def _setup_pinocchio(model, states, ref, result, log):
 
 
 def _setup_rtb(model, states, ref, result, log):
-    try:
-        import roboticstoolbox  # noqa: F401
-        from roboticstoolbox.robot import frne
-    except Exception as exc:
-        log(f'  RTB         : not importable ({type(exc).__name__}: {exc}); '
-            f'skipped')
-        result['valid']['rtb'] = None
+    frne = _peer('rtb', 'RTB', _import_rtb, result, log)
+    if frne is None:
         return None
     robot = peers.rtb_robot(model)
     got = []
