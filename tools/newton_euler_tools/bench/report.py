@@ -70,6 +70,19 @@ def _num(x):
     return f'{x:.2f}'
 
 
+def log_head(log, extra=''):
+    """Log a timing table's head (operation to verdict, then ``extra``)."""
+    head = (f'{"operation":<22}{"ours":>16}{"Pinocchio":>16}{"ours/pin":>10}'
+            f'  {"target":<22}{"verdict":<13}{extra}')
+    log(head)
+    log('-' * len(head))
+
+
+def ratio_text(verdict):
+    """Return a verdict's ours/Pinocchio ratio of minima as text, or -."""
+    return f'{verdict["ratio_min"]:.2f}' if 'ratio_min' in verdict else '-'
+
+
 def print_table(result, timer, log):
     T = result['timings']
     V = result['verdicts']
@@ -77,13 +90,10 @@ def print_table(result, timer, log):
     log(f'\n{result["robot"]}: microseconds per call, min (median) of '
         f'{timer.reps} repeats; ratio and verdict from the minima; '
         f'"!" = peer model failed the correctness check')
-    head = (f'{"operation":<22}{"ours":>16}{"Pinocchio":>16}{"ours/pin":>10}'
-            f'  {"target":<22}{"verdict":<13}{"RTB":>18}{"naive numpy":>18}')
-    log(head)
-    log('-' * len(head))
+    log_head(log, f'{"RTB":>18}{"naive numpy":>18}')
     for op in OPS:
         v = V[op]
-        ratio = f'{v["ratio_min"]:.2f}' if 'ratio_min' in v else '-'
+        ratio = ratio_text(v)
         log(f'{OP_LABELS[op]:<22}{_cell(T.get(("ours", op))):>16}'
             f'{_cell(T.get(("pin", op)), valid.get("pin")):>16}{ratio:>10}'
             f'  {v["target"]:<22}{v["verdict"]:<13}'

@@ -32,6 +32,7 @@ from newton_euler_ros.core import (coriolis_matrix, forward_dynamics,
                                    load_urdf, mass_matrix, Workspace)
 import numpy as np
 
+from .report import log_head, ratio_text
 from .. import peers
 
 TREES = {'centauro': 'centauro_description/urdf/centauro.urdf'}
@@ -135,15 +136,12 @@ def print_tree_table(result, timer, log):
     T, V = result['timings'], result['verdicts']
     log(f'\n{result["robot"]} whole tree ({result["dof"]} joints): '
         f'microseconds per call, min (median) of {timer.reps} repeats')
-    head = (f'{"operation":<22}{"ours":>16}{"Pinocchio":>16}{"ours/pin":>10}'
-            f'  {"target":<22}{"verdict":<13}')
-    log(head)
-    log('-' * len(head))
+    log_head(log)
     for op in TREE_OPS:
         ours, pin, v = T[('ours', op)], T.get(('pin', op)), V[op]
         cell = (lambda t: '-' if t is None else
                 f'{t["min_us"]:.2f} ({t["median_us"]:.2f})')
-        ratio = f'{v["ratio_min"]:.2f}' if 'ratio_min' in v else '-'
+        ratio = ratio_text(v)
         log(f'{TREE_LABELS[op]:<22}{cell(ours):>16}{cell(pin):>16}'
             f'{ratio:>10}  {v.get("target", "-"):<22}{v["verdict"]:<13}')
     log('  D: Pinocchio crba fills only the upper triangle; ours returns '
