@@ -49,6 +49,30 @@ uses_kernels(__file__)
 
 
 @njit(**ENTRY)
+def _damped_solve(J, n, rows, lam2, A, y):
+    """
+    Solve (G + lam2 I) x = y, x in y; False when the Cholesky fails.
+
+    G is the Gram matrix of the 6 x n Jacobian J's rows (``rows``:
+    J J^T, 6 x 6) or of its columns (J^T J, n x n); its lower triangle
+    is built in A and factored in place.
+    """
+    size = 6 if rows else n
+    for a in range(size):
+        for b in range(a + 1):
+            s = 0.0
+            if rows:
+                for j in range(n):
+                    s += J[a, j] * J[b, j]
+            else:
+                for c in range(6):
+                    s += J[c, a] * J[c, b]
+            A[a, b] = s
+        A[a, a] += lam2
+    return cholesky_solve(A, y, A, y) == -1     # in place
+
+
+@njit(**ENTRY)
 def _dls_wrench(J, r, damping, A, y, F):
     """
     F = (J J^T + damping^2 I)^-1 J r, the damped (J^T)^+ r.
@@ -65,26 +89,14 @@ def _dls_wrench(J, r, damping, A, y, F):
             for j in range(n):
                 s += J[a, j] * r[j]
             y[a] = s
-            for b in range(a + 1):
-                s = 0.0
-                for j in range(n):
-                    s += J[a, j] * J[b, j]
-                A[a, b] = s
-            A[a, a] += lam2
-        if cholesky_solve(A, y, A, y) != -1:     # in place
+        if not _damped_solve(J, n, True, lam2, A, y):
             return False
         for a in range(6):
             F[a] = y[a]
     else:
         for a in range(n):
             y[a] = r[a]
-            for b in range(a + 1):
-                s = 0.0
-                for c in range(6):
-                    s += J[c, a] * J[c, b]
-                A[a, b] = s
-            A[a, a] += lam2
-        if cholesky_solve(A, y, A, y) != -1:     # in place
+        if not _damped_solve(J, n, False, lam2, A, y):
             return False
         for c in range(6):
             s = 0.0
