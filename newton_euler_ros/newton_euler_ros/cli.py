@@ -377,7 +377,13 @@ def _chain_options(parser):
                              'below the base)')
 
 
-def _link_option(parser):
+def _wrench_options(parser, wrench_help, frame_help):
+    """Add --wrench (``wrench_help``), --wrench-frame and --link."""
+    parser.add_argument('--wrench', nargs=6,
+                        metavar=('FX', 'FY', 'FZ', 'NX', 'NY', 'NZ'),
+                        help=wrench_help)
+    parser.add_argument('--wrench-frame', choices=('base', 'end_effector'),
+                        default='base', help=frame_help)
     parser.add_argument('--link', metavar='LINK',
                         help='URDF only: the link the wrench acts at and '
                              'whose Jacobian is printed (default: the end '
@@ -411,15 +417,10 @@ def build_parser():
                      help='joint velocities (default zeros)')
     dyn.add_argument('--qdd', nargs='+', metavar='QDD',
                      help='joint accelerations (default zeros)')
-    dyn.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
-                                                   'NY', 'NZ'),
-                     help='wrench the end effector exerts on its '
-                          'environment (N, N m), moment about its origin')
-    dyn.add_argument('--wrench-frame', choices=('base', 'end_effector'),
-                     default='base', help='axes of --wrench and of the '
-                                          'Jacobian (default base; '
-                                          "end_effector: the frame's own)")
-    _link_option(dyn)
+    _wrench_options(dyn, 'wrench the end effector exerts on its '
+                         'environment (N, N m), moment about its origin',
+                    'axes of --wrench and of the Jacobian (default base; '
+                    "end_effector: the frame's own)")
     dyn.add_argument('--json', action='store_true',
                      help='print one JSON object')
     dyn.add_argument('--states', metavar='FILE.json',
@@ -458,14 +459,10 @@ def build_parser():
                     help='JSON: {"joint_names": [...], "points": '
                          '[{"time_from_start": t, "positions": [...], '
                          '...}]}')
-    ff.add_argument('--wrench', nargs=6, metavar=('FX', 'FY', 'FZ', 'NX',
-                                                  'NY', 'NZ'),
-                    help='wrench the end effector exerts along the whole '
-                         'trajectory')
-    ff.add_argument('--wrench-frame', choices=('base', 'end_effector'),
-                    default='base', help='axes of --wrench (default base; '
-                                         "end_effector: the frame's own)")
-    _link_option(ff)
+    _wrench_options(ff, 'wrench the end effector exerts along the whole '
+                        'trajectory',
+                    'axes of --wrench (default base; end_effector: the '
+                    "frame's own)")
     _chain_options(ff)
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
