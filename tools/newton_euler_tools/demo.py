@@ -210,16 +210,28 @@ class Recorder:
         self.rclpy.try_shutdown(context=self.context)
 
 
+def poll(predicate, what, check, pause, timeout=STARTUP_TIMEOUT):
+    """
+    Call ``pause()`` until ``predicate()``, ``check()`` before each.
+
+    ``check`` raises when a process has exited; DemoError after
+    ``timeout`` seconds, naming ``what`` was awaited.
+    """
+    end = time.monotonic() + timeout
+    while not predicate():
+        check()
+        if time.monotonic() > end:
+            raise DemoError(f'timed out after {timeout:.0f} s waiting for '
+                            f'{what}')
+        pause()
+
+
 def wait_for(recorder, children, predicate, what):
     """Spin until ``predicate()``; fail if a child exits or on timeout."""
-    end = time.monotonic() + STARTUP_TIMEOUT
-    while not predicate():
+    def check():
         for child in children:
             child.check_alive()
-        if time.monotonic() > end:
-            raise DemoError(f'timed out after {STARTUP_TIMEOUT} s waiting '
-                            f'for {what}')
-        recorder.spin_once(0.05)
+    poll(predicate, what, check, lambda: recorder.spin_once(0.05))
 
 
 COUNT = re.compile(r'commands (sent|received): (\d+)')

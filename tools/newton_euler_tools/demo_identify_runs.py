@@ -29,7 +29,7 @@ import time
 from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import (check_exits, Child, DemoError, Recorder,
+from .demo import (check_exits, Child, DemoError, poll, Recorder,
                    STARTUP_TIMEOUT)
 from .demo_pick import trajectory_message
 from .ident_example import BASE, TIP
@@ -309,14 +309,10 @@ class LoopRun:
 
 def wait_until(runs, predicate, what, timeout=STARTUP_TIMEOUT):
     """Poll ``predicate()``; fail if a process exits or on timeout."""
-    end = time.monotonic() + timeout
-    while not predicate():
+    def check():
         for r in runs:
             r.check()
-        if time.monotonic() > end:
-            raise DemoError(f'timed out after {timeout:.0f} s waiting for '
-                            f'{what}')
-        time.sleep(0.02)
+    poll(predicate, what, check, lambda: time.sleep(0.02), timeout)
 
 
 def drive(runs, duration):
