@@ -456,15 +456,26 @@ class Loop:
                 item.abort()
 
 
+def loop_parser(name, doc, quick):
+    """
+    Return an identification loop's parser: ``--out`` and ``--quick``.
+
+    ``name`` is the module (prog ``python -m newton_euler_tools.NAME``,
+    default ``--out`` out/NAME), ``doc`` its docstring (the description:
+    its first line) and ``quick`` what ``--quick`` shortens.
+    """
+    parser = argparse.ArgumentParser(
+        prog=f'python -m newton_euler_tools.{name}',
+        description=doc.strip().split('\n')[0])
+    parser.add_argument('--out', default=os.path.join('out', name))
+    parser.add_argument('--quick', action='store_true', help=quick)
+    return parser
+
+
 def parse_args(argv):
     """Parse the demo's command line."""
-    parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_tools.demo_identify',
-        description=__doc__.strip().split('\n')[0])
-    parser.add_argument('--out', default=os.path.join('out',
-                                                      'demo_identify'))
-    parser.add_argument('--quick', action='store_true',
-                        help='a short trajectory and optimisation (tests)')
+    parser = loop_parser('demo_identify', __doc__,
+                         'a short trajectory and optimisation (tests)')
     parser.add_argument('--seed', type=int, default=7)
     return parser.parse_args(argv)
 

@@ -48,7 +48,6 @@ identified), the trajectories, the recordings, each command's output,
 ``summary.md`` and ``summary.json`` (the figures and the wall time of
 each step).  No ROS process runs: the commands run in this process.
 """
-import argparse
 import csv
 import json
 import os
@@ -60,8 +59,8 @@ from newton_euler_ros.core.drives import model_drives
 import numpy as np
 
 from .demo import DemoError
-from .demo_identify import (ARMATURE, COULOMB, newton_euler, quiet_load,
-                            Steps, VISCOUS, warm_excite)
+from .demo_identify import (ARMATURE, COULOMB, loop_parser, newton_euler,
+                            quiet_load, Steps, VISCOUS, warm_excite)
 from .ident_example import BASE, panda_path, TIP
 from .mujoco_identify_plant import (DRIVER_RATE, feedforward_model,
                                     load_plant, NOISE, PHYSICS_STEP,
@@ -323,14 +322,8 @@ def write_report(loop, result):
 
 def parse_args(argv):
     """Parse the command line."""
-    parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_tools.mujoco_identify',
-        description=__doc__.strip().split('\n')[0])
-    parser.add_argument('--out', default=os.path.join('out',
-                                                      'mujoco_identify'))
-    parser.add_argument('--quick', action='store_true',
-                        help='shorter trajectories, less optimisation '
-                             '(tests)')
+    parser = loop_parser('mujoco_identify', __doc__,
+                         'shorter trajectories, less optimisation (tests)')
     parser.add_argument('--seed', type=int, default=7,
                         help='seed of the true robot (perturbation) and the '
                         'noise')
