@@ -74,10 +74,11 @@ python3 - "$WS/install" <<'PY'
 import os, sys
 install = sys.argv[1]
 import newton_euler_interfaces, newton_euler_ros
-from newton_euler_interfaces.srv import ComputeDynamics
+from newton_euler_interfaces.srv import ComputeDynamics, Linearize
 from rclpy.type_support import check_for_type_support
 from ament_index_python.packages import get_package_share_directory
 check_for_type_support(ComputeDynamics)
+check_for_type_support(Linearize)
 share = get_package_share_directory('newton_euler_ros')
 for what, path in [('newton_euler_interfaces', newton_euler_interfaces.__file__),
                    ('newton_euler_ros', newton_euler_ros.__file__),

@@ -243,10 +243,11 @@ if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok interfaces "$H_IFACE"; then
   # Import the service AND load its C type support (the .so files in
   # .venv/lib, found through the LD_LIBRARY_PATH the wheel bootstrap sets).
   "$VENV/bin/python" -c '
-from newton_euler_interfaces.srv import ComputeDynamics
+from newton_euler_interfaces.srv import ComputeDynamics, Linearize
 from rclpy.type_support import check_for_type_support
-check_for_type_support(ComputeDynamics)
-ComputeDynamics.Request(); ComputeDynamics.Response()
+for srv in (ComputeDynamics, Linearize):
+    check_for_type_support(srv)
+    srv.Request(); srv.Response()
 ' || die "newton_euler_interfaces was installed but does not import/load"
   stamp_write interfaces "$H_IFACE"
 fi
