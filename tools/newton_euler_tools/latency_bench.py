@@ -91,7 +91,6 @@ and on p99; with the observer on, p99 < 1 ms and nothing dropped.  The
 exit code is 0 when the run completed (1 with ``--strict`` and a MISS),
 2 when it could not run.
 """
-import argparse
 import gc
 import os
 import shlex
@@ -110,6 +109,7 @@ from .latency_traffic import (_StampClock, CONTACT_TOPIC, ECHO_TOPIC,
                               NODE_NAME, NODE_TOPIC, puma_model, random_walk,
                               raw_stamp_ns, WRENCH_TOPIC)
 from .processes import ChildProcess, first_domain
+from .timing import tool_parser
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 REPO_DIR = os.path.dirname(os.path.dirname(PACKAGE_DIR))
@@ -336,10 +336,9 @@ def _phase_result(key, result, t, child, args, command_topic):
 
 def parse_args(argv=None):
     """Return the command line's options (``--quick`` applied)."""
-    parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_tools.latency_bench',
-        description='Latency of inverse_dynamics_node (joint state in, '
-                    'torques out) at 1 kHz, against an echo node floor.')
+    parser = tool_parser(
+        'latency_bench', 'Latency of inverse_dynamics_node (joint state in, '
+                         'torques out) at 1 kHz, against an echo node floor.')
     parser.add_argument('--duration', type=float, default=10.0,
                         help='seconds of timed publishing per phase '
                              '(default 10)')

@@ -35,6 +35,21 @@ def min_time(fn, number=1, repeat=5):
     return best
 
 
+def tool_parser(module, description, quick=None):
+    """
+    Return the parser of ``python -m newton_euler_tools.MODULE``.
+
+    With ``quick`` (its help: what it cuts), its first option is
+    ``--quick``.
+    """
+    parser = argparse.ArgumentParser(
+        prog=f'python -m newton_euler_tools.{module}',
+        description=description)
+    if quick:
+        parser.add_argument('--quick', action='store_true', help=quick)
+    return parser
+
+
 def quick_option(doc, what, argv=None):
     """
     Return whether ``--quick`` is given: a small benchmark's only option.

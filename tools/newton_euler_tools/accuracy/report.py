@@ -24,7 +24,6 @@ Writes ``DIR/accuracy-vs-time.md`` (default ``docs/``), its PNGs under
 ``--quick`` (one state per robot, short repeats and simulations) is a
 smoke test that finishes in under a minute; its figures are noisier.
 """
-import argparse
 import datetime
 import json
 import os
@@ -46,6 +45,7 @@ from .tables import (ARITH_HEADER, arithmetic_rows, scaling_text,
 from .truth import GroundTruth
 from .. import peers
 from ..bench import Timer
+from ..timing import tool_parser
 
 CHAIN_SIZES = (6, 30, 100)
 
@@ -123,13 +123,11 @@ def run(args, log):
 
 def main(argv=None):
     """Run the report from the command line; return the exit status."""
-    parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_tools.accuracy',
-        description='Measure what accuracy costs in time and write '
-                    'docs/accuracy-vs-time.md with its plots.')
-    parser.add_argument('--quick', action='store_true',
-                        help='smoke test: one state per robot, short '
-                             'repeats and simulations (under a minute)')
+    parser = tool_parser(
+        'accuracy', 'Measure what accuracy costs in time and write '
+                    'docs/accuracy-vs-time.md with its plots.',
+        'smoke test: one state per robot, short repeats and simulations '
+        '(under a minute)')
     parser.add_argument('--out', default='docs', metavar='DIR',
                         help='where the report goes (default: docs)')
     parser.add_argument('--robot', action='append', metavar='NAME',

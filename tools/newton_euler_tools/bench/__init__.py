@@ -52,7 +52,6 @@ the peers, checked against ours), :mod:`.measure` (the timer and the
 timed groups), :mod:`.report` (verdicts and tables); here, one robot
 (:func:`bench_robot`) and the command (:func:`main`).
 """
-import argparse
 import json
 import os
 import platform
@@ -74,6 +73,7 @@ from .report import (json_default, jsonable, loadavg, print_breakdown,
                      print_table, verdicts)
 from .trees import bench_tree, DEFAULT_TREES, print_tree_table, TREES
 from .. import peers
+from ..timing import tool_parser
 
 __all__ = ['BATCH_STATES', 'BATCHES', 'bench_robot', 'DEFAULT_ROBOTS',
            'first_call_times', 'main', 'naive_mass_matrix', 'naive_rnea',
@@ -95,13 +95,11 @@ def bench_robot(name, timer, rng, log):
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(
-        prog='python -m newton_euler_tools.bench',
-        description='Time our dynamics against Pinocchio, Robotics Toolbox '
-                    'and naive numpy, and check the performance targets.')
-    parser.add_argument('--quick', action='store_true',
-                        help='fewer and shorter repeats (under 15 s); skips '
-                             'the cold-compile measurement')
+    parser = tool_parser(
+        'bench', 'Time our dynamics against Pinocchio, Robotics Toolbox '
+                 'and naive numpy, and check the performance targets.',
+        'fewer and shorter repeats (under 15 s); skips the cold-compile '
+        'measurement')
     parser.add_argument('--json', metavar='PATH',
                         help='write every figure to this JSON file')
     parser.add_argument('--robot', action='append', metavar='NAME',
