@@ -94,29 +94,22 @@ def findings(records, context):
             f'float32 operation costs what one float64 operation costs), '
             f'while its error is {_span(errs32, fmt_err)} against '
             f'{_span(errs64, fmt_err)} in float64.')
-    t_ratio, e_crba, e_ne, dofs = _compare(records, [
-        (robot, 'D', 'float64, CRBA', 'float64, n recursions')
-        for robot in robots])
-    if t_ratio:
-        k = max(range(len(dofs)), key=lambda i: dofs[i][0])
-        out.append(
-            f'- **D(q): the composite-rigid-body algorithm** takes '
-            f'{_span(t_ratio, lambda x: f"{x:.2f}x")} the time of n '
-            f'Newton-Euler recursions ({t_ratio[k]:.2f}x on {dofs[k][1]}, '
-            f'{dofs[k][0]} links), at an error of {_span(e_crba, fmt_err)} '
-            f'against {_span(e_ne, fmt_err)}.')
-    for quantity, fast, slow, what in (
+    for quantity, fast, slow, what, than in (
+            ('D', 'float64, CRBA', 'float64, n recursions',
+             'D(q): the composite-rigid-body algorithm',
+             'n Newton-Euler recursions'),
             ('C', 'float64, composite, O(n^2)', 'float64, n recursions',
-             'C(q, qd): the composite-body algorithm'),
+             'C(q, qd): the composite-body algorithm', 'n recursions'),
             ('FD', 'float64, ABA, O(n)', 'float64, Cholesky of D',
-             'Forward dynamics: the articulated-body algorithm')):
+             'Forward dynamics: the articulated-body algorithm',
+             'Cholesky of D')):
         t_ratio, e_fast, e_slow, dofs = _compare(records, [
             (robot, quantity, fast, slow) for robot in robots])
         if t_ratio:
             k = max(range(len(dofs)), key=lambda i: dofs[i][0])
             out.append(
                 f'- **{what}** takes {_span(t_ratio, lambda x: f"{x:.2f}x")} '
-                f'the time of {slow.split(", ", 1)[1]} ({t_ratio[k]:.2f}x on '
+                f'the time of {than} ({t_ratio[k]:.2f}x on '
                 f'{dofs[k][1]}, {dofs[k][0]} links), at an error of '
                 f'{_span(e_fast, fmt_err)} against {_span(e_slow, fmt_err)}.')
     t_ratio, e_fd, e_ex, _ = _compare(records, [
