@@ -222,14 +222,14 @@ class FeedforwardComputer:
         self.last_q, self.last_qd = q, qd   # only usable states count
         return self.order.to_output_order(tau)
 
-    def terms(self, names, position, velocity, acceleration, now):
+    def request_state(self, names, position, velocity):
         """
-        D, C, g, tau in output order for a service request.
+        (q, qd) of a service request, model order, or InputRejected.
 
-        Empty position/velocity mean the latest measured state; empty
-        acceleration means zeros.
+        An empty position means the latest measured state (its velocities
+        too when velocity is empty); with a position given, an empty
+        velocity means zeros.
         """
-        n = self.model.n
         if len(position) == 0:
             if self.last_q is None:
                 raise InputRejected('no_state', 'no position given and no '
@@ -239,9 +239,20 @@ class FeedforwardComputer:
             q = self.order.gather(names, 'position', position)
         if len(velocity) == 0:
             qd = self.last_qd if (len(position) == 0 and self.last_qd
-                                  is not None) else np.zeros(n)
+                                  is not None) else np.zeros(self.model.n)
         else:
             qd = self.order.gather(names, 'velocity', velocity)
+        return q, qd
+
+    def terms(self, names, position, velocity, acceleration, now):
+        """
+        D, C, g, tau in output order for a service request.
+
+        Empty position/velocity mean the latest measured state; empty
+        acceleration means zeros.
+        """
+        n = self.model.n
+        q, qd = self.request_state(names, position, velocity)
         qdd = (np.zeros(n) if len(acceleration) == 0 else
                self.order.gather(names, 'acceleration', acceleration))
         w, frame = self.wrench.current(now)

@@ -39,7 +39,9 @@ Publishes
     ~/external_wrench (geometry_msgs/WrenchStamped), ~/contact
     (std_msgs/Bool)
 Serves
-    ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics)
+    ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics),
+    ~/linearize (newton_euler_interfaces/srv/Linearize; the handler:
+    ``linearize_service``)
 """
 import collections
 import sys
@@ -48,7 +50,7 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray
 from geometry_msgs.msg import WrenchStamped
-from newton_euler_interfaces.srv import ComputeDynamics
+from newton_euler_interfaces.srv import ComputeDynamics, Linearize
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from sensor_msgs.msg import JointState
@@ -61,6 +63,7 @@ from .common import (check_parameters, ConfigurationError,
 from .inverse_dynamics_reports import (answer, diagnostics, failed,
                                        mimic_line, model_line,
                                        no_model_text, UpdateTimes)
+from .linearize_service import answer_linearize
 from .node_observer import NodeObserver
 from ..core import inspect_robot, NewtonEulerError
 from ..core.robot_file import Note
@@ -178,6 +181,8 @@ class InverseDynamicsNode(SharedGraphNode):
                                  reliability=ReliabilityPolicy.RELIABLE)
         self.create_service(ComputeDynamics, '~/compute_dynamics',
                             self._on_compute_dynamics, qos_profile=service_qos)
+        self.create_service(Linearize, '~/linearize', self._on_linearize,
+                            qos_profile=service_qos)
         if p['diagnostics_period'] > 0.0:
             self.diag_pub = self.create_publisher(DiagnosticArray,
                                                   '/diagnostics', 10,
@@ -475,13 +480,20 @@ class InverseDynamicsNode(SharedGraphNode):
         self.counts['trajectories'] += 1
 
     def _on_compute_dynamics(self, request, response):
+        return self._serve(answer, request, response)
+
+    def _on_linearize(self, request, response):
+        return self._serve(answer_linearize, request, response)
+
+    def _serve(self, fill, request, response):
+        """Answer every request: ``fill`` it, or say why it failed."""
         self.counts['service_calls'] += 1
         ff = self.ff
         if ff is None:
             self.counts['service_failures'] += 1
             return failed(response, self._no_model_text())
         try:
-            return answer(response, ff, request, self._now())
+            return fill(response, ff, request, self._now())
         except (InputRejected, NewtonEulerError) as exc:
             message = str(exc)
         except Exception as exc:
