@@ -20,7 +20,10 @@ does not expire); this process publishes a joint state and a wrench and
 calls the service: A, B, the discrete pair, tau0 and qdd0 against
 ``core.linearize.state_space`` in the node's order, the latest measured
 state for an empty request, and the refusals (a joint missing, named; a
-NaN; effort and acceleration both given; a negative time step).
+NaN; effort and acceleration both given; a negative time step).  Then
+the handler without ROS: a robot that adds gravity itself (u without
+g(q)), a scene's friction and rotor inertia, a scene without the
+velocity products refused.
 """
 import math
 import warnings
@@ -169,3 +172,50 @@ def test_bad_requests_are_refused_with_the_reason(probe, model):
     # and good requests work afterwards; nothing was an internal error
     assert call(probe).success
     assert 'internal error' not in probe.node_log()
+
+
+# ---- the handler without ROS: what the node's settings change ----
+
+def computer(model=None, scene=None, **kwargs):
+    from newton_euler_ros.feedforward import FeedforwardComputer
+    from newton_euler_ros.joint_inputs import JointOrder
+    from newton_euler_ros.wrenches import WrenchInput
+    names = (scene.model if model is None else model).joint_names
+    return FeedforwardComputer(model, JointOrder(names), WrenchInput([], []),
+                               None, scene, **kwargs)
+
+
+def test_a_robot_that_adds_gravity_is_linearised_without_it(model):
+    """robot_compensates_gravity: u is the torque sent, without g(q)."""
+    from newton_euler_ros.nodes.linearize_service import linearize
+    ff = computer(model, robot_compensates_gravity=True)
+    names = list(model.joint_names)
+    lin = linearize(ff, names, Q, QD, [], [], 0.0, 0.0)
+    want = state_space(model, Q, QD, gravity=False)
+    np.testing.assert_allclose(lin.A, want.A, rtol=1e-12, atol=1e-12)
+    # the torque the node would send for qdd = 0: g(q) left out
+    D, C, g, tau = ff.terms(names, Q, QD, [], 0.0)
+    np.testing.assert_allclose(lin.tau0, tau, rtol=1e-12, atol=1e-12)
+
+
+def test_a_scenes_friction_and_rotor_inertia_join_the_dynamics():
+    from newton_euler_ros.nodes.linearize_service import linearize
+    from newton_euler_ros.sim.scene import load_scene
+    press = load_scene('puma_payload_press')     # friction, rotor inertia
+    ff = computer(scene=press)
+    names = list(press.model.joint_names)
+    qdd = np.linspace(-1.0, 1.0, 6)
+    qd = np.array([0.3, -0.3, 0.4, 0.25, -0.5, 0.3])
+    lin = linearize(ff, names, Q, qd, [], qdd, 0.0, 0.0)
+    # the node's own torque at the point: its Coulomb friction is
+    # F_c sign(qd), here F_c tanh(qd / 0.02), equal 12 widths from rest
+    D, C, g, tau = ff.terms(names, Q, qd, qdd, 0.0)
+    np.testing.assert_allclose(lin.tau0, tau, rtol=1e-9, atol=1e-9)
+    # dqdd/dtau = (D + I_a)^-1 and dqdd/dqd has the viscous term
+    np.testing.assert_allclose(lin.B[6:] @ D, np.eye(6), atol=1e-9)
+    bare = state_space(ff.model, Q, qd, qdd=qdd)
+    assert np.abs(lin.A[6:, 6:] - bare.A[6:, 6:]).max() > 0.1
+    slow = load_scene('panda_slow_earth')        # no velocity products
+    ff = computer(scene=slow)
+    with pytest.raises(Exception, match='leaves out the velocity products'):
+        linearize(ff, [], [], [], [], [], 0.0, 0.0)
