@@ -17,7 +17,8 @@ inverse_dynamics_node: joint states (and a wrench) in, torques out.
 
 A thin adapter: messages are converted to numpy, the library computes, the
 result is published (the ROS-free layer: ``feedforward``, built by
-``feedforward_build``; the reports: ``inverse_dynamics_reports``).
+``feedforward_build``; the reports: ``inverse_dynamics_reports``; the
+linearisation: ``linearize_service``).
 docs/node.md describes the whole interface.  With a URDF and no tip_link
 it serves the whole robot below base_link (a tree, mimic joints): joint
 states from several drivers merged, wrenches at the links their frames
@@ -40,8 +41,8 @@ Publishes
     (std_msgs/Bool)
 Serves
     ~/compute_dynamics (newton_euler_interfaces/srv/ComputeDynamics),
-    ~/linearize (newton_euler_interfaces/srv/Linearize; the handler:
-    ``linearize_service``)
+    ~/linearize (newton_euler_interfaces/srv/Linearize): A, B of the
+    dynamics at a state, and their discrete pair
 """
 import collections
 import sys
