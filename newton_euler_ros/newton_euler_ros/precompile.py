@@ -101,9 +101,14 @@ def _exercise(model):
 
     from .core import (coriolis_matrix, coriolis_matrix_batch,
                        Float32Dynamics, forward_dynamics,
-                       forward_dynamics_batch, gravity_torques,
+                       forward_dynamics_batch,
+                       forward_dynamics_derivatives,
+                       forward_dynamics_derivatives_batch, gravity_torques,
                        gravity_torques_batch, inverse_dynamics,
-                       inverse_dynamics_batch, jacobian, link_poses,
+                       inverse_dynamics_batch,
+                       inverse_dynamics_derivatives,
+                       inverse_dynamics_derivatives_batch, jacobian,
+                       link_poses,
                        mass_matrix, mass_matrix_batch, MomentumObserver,
                        regressor_batch)
     from .core.observer import (contact_step, external_wrench,
@@ -138,6 +143,13 @@ def _exercise(model):
     forward_dynamics_batch(model, Q, Q, Q)
     regressor_batch(model, Q, Q, Q)
     regressor_batch(model, Q, Q, Q, drives=True)
+    inverse_dynamics_derivatives(model, q, z, z, w)
+    forward_dynamics_derivatives(model, q, z, tau, w)
+    inverse_dynamics_derivatives_batch(model, Q, Q, Q)
+    forward_dynamics_derivatives_batch(model, Q, Q, Q)
+    if links:
+        inverse_dynamics_derivatives(model, q, z, z, links, 'link')
+        forward_dynamics_derivatives(model, q, z, tau, links, 'link')
     f32 = Float32Dynamics(model)
     f32.inverse_dynamics(q, z, z, w)
     f32.mass_matrix(q)

@@ -352,6 +352,33 @@ class PinocchioTree:
                 out[f'J {link} {axes}'] = J[:, iv].copy()
         return out
 
+    def derivatives(self, q, qd, qdd, tau):
+        """
+        Pinocchio's analytical derivatives, rows and columns ours.
+
+        ``computeRNEADerivatives`` on the mimic-free model at (G q + o,
+        G qd, G qdd), mapped by G^T X G (tau of our coordinates is G^T
+        tau_full): dtau/dq, dtau/dqd.  Without mimic joints also
+        ``computeABADerivatives`` at (q, qd, tau): dqdd/dq, dqdd/dqd,
+        dqdd/dtau (its Minv, the upper triangle mirrored); with them it
+        has no counterpart (the constrained accelerations are not the
+        free model's).
+        """
+        pin, G = self.pin, self.G
+        dq, dv, _ = pin.computeRNEADerivatives(
+            self.full, self.full_data, self.full_config(q), G @ qd, G @ qdd)
+        out = {'dtau_dq': G.T @ dq @ G, 'dtau_dqd': G.T @ dv @ G}
+        if self.full.nv != self.model.nv:
+            return out
+        ix = np.ix_(self.iv, self.iv)
+        dq, dv, Minv = pin.computeABADerivatives(
+            self.model, self.data, self.config(q), self.vector(qd),
+            self.vector(tau))
+        Minv = np.triu(Minv) + np.triu(Minv, 1).T
+        out.update(dqdd_dq=dq[ix].copy(), dqdd_dqd=dv[ix].copy(),
+                   dqdd_dtau=Minv[ix].copy())
+        return out
+
     def regressor(self, q, qd, qdd):
         """
         ``pin.computeJointTorqueRegressor``, rows and body columns ours.

@@ -23,6 +23,10 @@ of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``,
 and rotor inertia, and :mod:`newton_euler_ros.core.observer` for the
 momentum observer.
 """
+from .derivatives import (forward_dynamics_derivatives,
+                          forward_dynamics_derivatives_batch,
+                          inverse_dynamics_derivatives,
+                          inverse_dynamics_derivatives_batch)
 from .drives import Drives
 from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
                        end_effector_pose, forward_dynamics,
@@ -45,7 +49,9 @@ from .workspace import Workspace
 
 __all__ = [
     'Drives', 'DynamicsInputError', 'EffectDynamics', 'Effects',
-    'Float32Dynamics', 'MomentumObserver', 'load_urdf', 'model_to_urdf',
+    'Float32Dynamics', 'forward_dynamics_derivatives',
+    'forward_dynamics_derivatives_batch', 'inverse_dynamics_derivatives',
+    'inverse_dynamics_derivatives_batch', 'MomentumObserver', 'load_urdf', 'model_to_urdf',
     'observe_recording', 'regressor', 'regressor_batch',
     'NewtonEulerError', 'NotPositiveDefiniteError', 'RobotFileError', 'RobotFileWarning',
     'RobotModel', 'Workspace', 'bundled_robots', 'coriolis_matrix',

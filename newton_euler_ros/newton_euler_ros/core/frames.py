@@ -256,6 +256,50 @@ def link_wrench_rows(model, q, wrenches, wrench_frame, ws):
     return rows
 
 
+def derivative_wrench_rows(model, q, wrenches, wrench_frame, ws):
+    """
+    Return (fall, fext, wext): wrenches at links for the derivatives.
+
+    ``fall`` (``ws.fall``) holds them all as :func:`link_wrench_rows`
+    does, in link axes at the current pose (their value).  For their
+    derivatives, those in the frame's own axes turn with the link: into
+    ``fext`` (``ws.fext``), as the recursion's rows.  Those in base axes
+    keep their direction while the link moves their point: row j of
+    ``wext`` (``ws.wext``) sums, over those on joint j's link, in
+    frame-0 axes with P the frame's origin, the moment about frame 0's
+    origin n + P x f, the force f, and M = P f^T - (P . f) 1 (the
+    kernels' ``DW_W``).
+    """
+    fall, fext, wext = ws.fall, ws.fext, ws.wext
+    fall[:] = 0.0
+    fext[:] = 0.0
+    wext[:] = 0.0
+    poses = None
+    for _, body, T, F, frame in _wrenches(model, wrenches, wrench_frame):
+        if body < 0:
+            continue
+        R, p = T[:3, :3], T[:3, 3]
+        if frame == 'link':
+            f = R @ F[:3]
+            row = np.concatenate([f, R @ F[3:] + np.cross(p, f)])
+            fext[body] += row
+            fall[body] += row
+            continue
+        if poses is None:
+            poses = _poses_array(model, q, ws).copy()
+        R0, t0 = poses[0, :9].reshape(3, 3), poses[0, 9:]
+        Rj, pj = poses[body + 1, :9].reshape(3, 3), poses[body + 1, 9:]
+        f = Rj.T @ F[:3]
+        fall[body, :3] += f
+        fall[body, 3:] += Rj.T @ F[3:] + np.cross(p, f)
+        P = R0.T @ (pj + Rj @ p - t0)
+        f, n = R0.T @ F[:3], R0.T @ F[3:]
+        wext[body, :3] += n + np.cross(P, f)
+        wext[body, 3:6] += f
+        wext[body, 6:] += (np.outer(P, f) - (P @ f) * np.eye(3)).ravel()
+    return fall, fext, wext
+
+
 def wrench_torques(model, q, wrench, wrench_frame='base', *, ws=None):
     """
     J(q)^T F_e: the joint forces that balance wrenches by virtual work.

@@ -42,10 +42,13 @@ def args():
         'tau': q.copy(), 'wrench': np.zeros(6), 'flags': 3, 'crba': True,
         'composite': True, 'local': False, 'body': n - 1,
         'target': model.frames_array[K.F_TOOL], 'fext': ws.fext,
+        'fall': ws.fall,
         'ws': ws.ws, 'aw': ws.aw,
         'cw': ws.cw, 'scratch': ws.scratch, 'Ts': ws.frames,
         'D': np.empty((n, n)), 'C': np.empty((n, n)), 'J': np.empty((6, n)),
-        'terms': np.empty((3, n)),
+        'terms': np.empty((3, n)), 'dw': ws.dw, 'wext': ws.wext,
+        'damping': ws.zeros, 'armature': ws.zeros, 'chol': ws.chol,
+        'dtau': np.empty((2, n, n)), 'dqdd': np.empty((3, n, n)),
     }
 
 

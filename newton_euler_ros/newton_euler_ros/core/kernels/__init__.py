@@ -28,6 +28,8 @@ file                   what it holds
 ``crba.py``            D(q) by the composite-rigid-body algorithm
 ``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
 ``aba.py``             qdd by the articulated-body algorithm
+``derivatives.py``     dtau/dq, dtau/dqd and dqdd/d(q, qd, tau),
+                       analytically, from the composite-body passes
 ``kinematics.py``      the tree (parents, branch points, mimic joints'
                        coordinates), joint placements, link poses, spatial
                        inertias and the Jacobian of any link
@@ -75,8 +77,8 @@ from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH,
                      C_HALF, C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC,
                      CW_BCA, CW_F1, CW_F2, CW_G, CW_I, CW_ICA, CW_OW, CW_RW,
-                     CW_S, CW_SD, CW_V, CW_WIDTH, F_BASE, F_CONST, F_GRAV,
-                     F_ROWS, F_TOOL, F_TREE, flags, GRAVITY, L_BODY, L_COM,
+                     CW_S, CW_SD, CW_V, CW_WIDTH, DW_WIDTH, F_BASE, F_CONST,
+                     F_GRAV, F_ROWS, F_TOOL, F_TREE, flags, GRAVITY, L_BODY, L_COM,
                      L_INERTIA, L_LEAD, L_MASS, L_MULT, L_OFFSET, L_P,
                      L_PARENT, L_R, L_STORE, L_TYPE, L_WIDTH, LINK_WRENCHES,
                      MIMIC, NONFINITE, OVERFLOW, pack, SINGULAR, SIZE,
@@ -93,7 +95,8 @@ __all__ = [
     'cholesky_solve', 'CONSTANTS', 'coriolis_matrix_columns',
     'coriolis_matrix_composite', 'CS_BC', 'CS_H', 'CS_IC', 'CW_BCA',
     'CW_F1', 'CW_F2', 'CW_G', 'CW_I', 'CW_ICA', 'CW_OW', 'CW_RW', 'CW_S',
-    'CW_SD', 'CW_V', 'CW_WIDTH', 'ENTRY', 'F_BASE', 'F_CONST', 'F_GRAV',
+    'CW_SD', 'CW_V', 'CW_WIDTH', 'DW_WIDTH', 'ENTRY', 'F_BASE', 'F_CONST',
+    'F_GRAV',
     'F_ROWS', 'F_TOOL', 'F_TREE', 'first_nonfinite', 'flags',
     'forward_kinematics', 'GRAVITY', 'jacobian', 'joint_trig', 'L_BODY',
     'L_COM', 'L_INERTIA', 'L_LEAD', 'L_MASS', 'L_MULT', 'L_OFFSET', 'L_P',
@@ -115,8 +118,8 @@ __all__ += sorted(RUN)
 
 # the kernel files in the order they import each other
 MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
-           'newton_euler', 'crba', 'coriolis', 'aba', 'regressor',
-           'generate', 'entry')
+           'newton_euler', 'crba', 'coriolis', 'aba', 'derivatives',
+           'regressor', 'generate', 'entry')
 _DIR = os.path.dirname(os.path.abspath(__file__))
 
 

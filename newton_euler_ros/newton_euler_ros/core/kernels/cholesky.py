@@ -29,6 +29,20 @@ def cholesky_solve(A, b, L, x):
     in place (each entry of A is read before its L entry overwrites it,
     and b[i] before x[i]); the observer's damped solve uses that.
     """
+    bad = cholesky_factor(A, L)
+    if bad >= 0:
+        return bad
+    cholesky_solve_factored(L, b, x)
+    return -1
+
+
+@njit(cache=True, inline='always')
+def cholesky_factor(A, L):
+    """
+    Write the lower Cholesky factor of A into L (A = L L^T).
+
+    Returns -1, or the first pivot that is not positive.  L may be A.
+    """
     n = A.shape[0]
     for i in range(n):
         for k in range(i + 1):
@@ -41,6 +55,13 @@ def cholesky_solve(A, b, L, x):
                 L[i, i] = math.sqrt(acc)
             else:
                 L[i, k] = acc / L[k, k]
+    return -1
+
+
+@njit(cache=True, inline='always')
+def cholesky_solve_factored(L, b, x):
+    """Solve L L^T x = b (x may be b)."""
+    n = L.shape[0]
     for i in range(n):
         acc = b[i]
         for m in range(i):
@@ -51,4 +72,3 @@ def cholesky_solve(A, b, L, x):
         for m in range(i + 1, n):
             acc -= L[m, i] * x[m]
         x[i] = acc / L[i, i]
-    return -1

@@ -23,9 +23,13 @@ from ._jit import njit
 from .kinematics import (body_inertia, branch_point, branched, has_mimic,
                          joint_rate, joint_trig, link_geometry, parent,
                          put_pair, revolute, zero_matrix)
-from .layout import (C_HALF, C_ONE, C_ZERO, CW_F1, CW_F2, CW_G, CW_I, CW_ICA,
-                     CW_OW, CW_RW, CW_S, CW_SD, CW_V, F_CONST, OVERFLOW)
-from .spatial import cross, load3, load9, mat6_vec, matmul, rot, skew, vec6
+from .layout import (C_HALF, C_ONE, C_ZERO, CS_BC, CS_H, CS_IC, CW_F1, CW_F2,
+                     CW_G, CW_I, CW_ICA, CW_OW, CW_RW, CW_S, CW_SD, CW_V,
+                     DS_F, DS_W, DW_A, DW_ACC, DW_C, DW_E, DW_T, DW_U, DW_W,
+                     DW_Y,
+                     F_CONST, OVERFLOW)
+from .spatial import (cross, load3, load9, mat6_vec, matmul, rot, rot_t, skew,
+                      vec6)
 from .status import matrix_status
 
 
@@ -89,7 +93,7 @@ def coriolis_forward(links, frames, qd, ws, cw):
 
 
 @njit(cache=True, inline='always')
-def coriolis_backward(links, frames, cw):
+def coriolis_backward(links, frames, cw, dw, derivatives):
     """
     Coriolis pass 2, tip to base: composite inertia and Coriolis matrices.
 
@@ -101,75 +105,171 @@ def coriolis_backward(links, frames, cw):
     F1 = IC S, F2 = BC^T S and G = IC Sdot + BC S.  The running composite
     is kept in the scratch row nb; at a branch it is added into the
     parent's ``CW_ICA``, ``CW_BCA`` sums, which the parent adds in turn.
+    With ``derivatives`` the composite wrench is summed beside them in
+    ``dw`` (:func:`wrench_step`; ``derivatives.derivative_forward`` must
+    have filled ``dw``).
     """
     n = links.shape[0]
-    half = frames[F_CONST, C_HALF]
     zero = frames[F_CONST, C_ZERO]
-    IC = 0          # scratch row n: IC, BC, I_j V_j
-    BC = 36
-    H = 72
     for k in range(72):
         cw[n, k] = zero
+    if derivatives:
+        for k in range(21):
+            dw[n, k] = zero
     for j in range(n - 1, -1, -1):
         if branch_point(links, frames, j):      # the later children's
             for k in range(72):
                 cw[n, k] += cw[j, CW_ICA + k]
-        Rw = load9(cw, j, CW_RW)
-        ow = load3(cw, j, CW_OW)
-        body_inertia(links, j, Rw, ow, cw, j, CW_I)
-        V = vec6(cw, j, CW_V)
-        mat6_vec(cw, j, CW_I, V, cw, n, H)
-        h = vec6(cw, n, H)
-        # Y = (V x*) I, with V x* = [[w x, v x], [0, w x]], column by
-        # column: Y e = V x* (I e).  B = (Y + Y^T + H) / 2 with
-        # H = [h]^ = [[-[h_n], -[h_f]], [-[h_f], 0]].
-        Hn = skew((h[0], h[1], h[2]))
-        Hf = skew((h[3], h[4], h[5]))
-        for col in range(6):
-            b = CW_I + col
-            m0 = cw[j, b]
-            m1 = cw[j, b + 6]
-            m2 = cw[j, b + 12]
-            f0 = cw[j, b + 18]
-            f1 = cw[j, b + 24]
-            f2 = cw[j, b + 30]
-            t1 = cross(V[0], V[1], V[2], m0, m1, m2)
-            t2 = cross(V[3], V[4], V[5], f0, f1, f2)
-            t3 = cross(V[0], V[1], V[2], f0, f1, f2)
-            y = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2],
-                 t3[0], t3[1], t3[2])
-            for r in range(6):
-                # Y[r, col] goes to B[r, col] and, as Y^T, to B[col, r]
-                cw[n, BC + 6 * r + col] += half * y[r]
-                cw[n, BC + 6 * col + r] += half * y[r]
-        for r in range(3):
-            for s in range(3):
-                cw[n, BC + 6 * r + s] -= half * Hn[3 * r + s]
-                cw[n, BC + 6 * r + s + 3] -= half * Hf[3 * r + s]
-                cw[n, BC + 6 * (r + 3) + s] -= half * Hf[3 * r + s]
-        for k in range(36):
-            cw[n, IC + k] += cw[j, CW_I + k]
-        S = vec6(cw, j, CW_S)
-        Sd = vec6(cw, j, CW_SD)
-        for r in range(6):
-            f1 = zero
-            f2 = zero
-            g = zero
-            for s in range(6):
-                ic = cw[n, IC + 6 * r + s]
-                f1 += ic * S[s]
-                f2 += cw[n, BC + 6 * s + r] * S[s]
-                g += ic * Sd[s] + cw[n, BC + 6 * r + s] * S[s]
-            cw[j, CW_F1 + r] = f1
-            cw[j, CW_F2 + r] = f2
-            cw[j, CW_G + r] = g
+            if derivatives:
+                for k in range(21):
+                    dw[n, k] += dw[j, DW_ACC + k]
+        body_step(links, frames, cw, j, n)
+        if derivatives:
+            wrench_step(links, frames, cw, dw, j, n)
+        coriolis_vectors(frames, cw, j, n)
         par = parent(links, j)
         if par != j - 1:        # a branch: into the parent's sums
             if par >= 0:
                 for k in range(72):
                     cw[par, CW_ICA + k] += cw[n, k]
+                if derivatives:
+                    for k in range(21):
+                        dw[par, DW_ACC + k] += dw[n, k]
             for k in range(72):
                 cw[n, k] = zero
+            if derivatives:
+                for k in range(21):
+                    dw[n, k] = zero
+
+
+@njit(cache=True, inline='always')
+def body_step(links, frames, cw, j, n):
+    """
+    Add body j to the running composites IC and BC (scratch row n).
+
+    Writes I_j (frame 0, ``CW_I``) and h_j = I_j V_j (scratch ``CS_H``).
+    """
+    half = frames[F_CONST, C_HALF]
+    BC = CS_BC
+    Rw = load9(cw, j, CW_RW)
+    ow = load3(cw, j, CW_OW)
+    body_inertia(links, j, Rw, ow, cw, j, CW_I)
+    V = vec6(cw, j, CW_V)
+    mat6_vec(cw, j, CW_I, V, cw, n, CS_H)
+    h = vec6(cw, n, CS_H)
+    # Y = (V x*) I, with V x* = [[w x, v x], [0, w x]], column by
+    # column: Y e = V x* (I e).  B = (Y + Y^T + H) / 2 with
+    # H = [h]^ = [[-[h_n], -[h_f]], [-[h_f], 0]].
+    Hn = skew((h[0], h[1], h[2]))
+    Hf = skew((h[3], h[4], h[5]))
+    for col in range(6):
+        b = CW_I + col
+        m0 = cw[j, b]
+        m1 = cw[j, b + 6]
+        m2 = cw[j, b + 12]
+        f0 = cw[j, b + 18]
+        f1 = cw[j, b + 24]
+        f2 = cw[j, b + 30]
+        t1 = cross(V[0], V[1], V[2], m0, m1, m2)
+        t2 = cross(V[3], V[4], V[5], f0, f1, f2)
+        t3 = cross(V[0], V[1], V[2], f0, f1, f2)
+        y = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2],
+             t3[0], t3[1], t3[2])
+        for r in range(6):
+            # Y[r, col] goes to B[r, col] and, as Y^T, to B[col, r]
+            cw[n, BC + 6 * r + col] += half * y[r]
+            cw[n, BC + 6 * col + r] += half * y[r]
+    for r in range(3):
+        for s in range(3):
+            cw[n, BC + 6 * r + s] -= half * Hn[3 * r + s]
+            cw[n, BC + 6 * r + s + 3] -= half * Hf[3 * r + s]
+            cw[n, BC + 6 * (r + 3) + s] -= half * Hf[3 * r + s]
+    for k in range(36):
+        cw[n, CS_IC + k] += cw[j, CW_I + k]
+
+
+@njit(cache=True, inline='always')
+def coriolis_vectors(frames, cw, j, n):
+    """F1 = IC S, F2 = BC^T S, G = IC Sdot + BC S of joint j (composites)."""
+    zero = frames[F_CONST, C_ZERO]
+    S = vec6(cw, j, CW_S)
+    Sd = vec6(cw, j, CW_SD)
+    for r in range(6):
+        f1 = zero
+        f2 = zero
+        g = zero
+        for s in range(6):
+            ic = cw[n, CS_IC + 6 * r + s]
+            f1 += ic * S[s]
+            f2 += cw[n, CS_BC + 6 * s + r] * S[s]
+            g += ic * Sd[s] + cw[n, CS_BC + 6 * r + s] * S[s]
+        cw[j, CW_F1 + r] = f1
+        cw[j, CW_F2 + r] = f2
+        cw[j, CW_G + r] = g
+
+
+@njit(cache=True, inline='always')
+def wrench_step(links, frames, cw, dw, j, n):
+    """
+    Add link j's wrench to the composite wrench; Y_j and U_j for dtau/dq.
+
+    The link's wrench from its motion, f_j = I_j A_j + V_j x* h_j, and the
+    one it exerts on its environment (``DW_E``) go into the running
+    composite F (the wrench joint j carries: tau_j = S_j . F_j, written
+    to ``DW_T``), its fixed-direction wrenches' data into W.  Then, with the composites at
+    j (body j's already added):
+
+    - Y_j = S_j x* F_j - IC_j c_j + 2 BC_j Sdot_j + Delta_j, where
+      Delta_j = [M w_j - w_j x n; -w_j x f] (n, f, M: the W sums and
+      w_j the angular part of S_j) corrects the rigid carry of wrenches
+      whose directions stay fixed;
+    - U_j = M^T s_w - n x s_w - f x s_v (S_j = [s_w; s_v]).
+    """
+    A = vec6(dw, j, DW_A)
+    V = vec6(cw, j, CW_V)
+    h = vec6(cw, n, CS_H)
+    # V x* h = [w x h_n + v x h_f; w x h_f]
+    a = cross(V[0], V[1], V[2], h[0], h[1], h[2])
+    b = cross(V[3], V[4], V[5], h[3], h[4], h[5])
+    c = cross(V[0], V[1], V[2], h[3], h[4], h[5])
+    vh = (a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2])
+    for r in range(6):
+        x = vh[r] + dw[j, DW_E + r]
+        for s in range(6):
+            x += cw[j, CW_I + 6 * r + s] * A[s]
+        dw[n, DS_F + r] += x
+    for k in range(15):
+        dw[n, DS_W + k] += dw[j, DW_W + k]
+    S = vec6(cw, j, CW_S)
+    Sd = vec6(cw, j, CW_SD)
+    C = vec6(dw, j, DW_C)
+    F = vec6(dw, n, DS_F)
+    dw[j, DW_T] = ((S[0] * F[0] + S[1] * F[1] + S[2] * F[2])
+                   + (S[3] * F[3] + S[4] * F[4] + S[5] * F[5]))
+    nw = load3(dw, n, DS_W)
+    fw = load3(dw, n, DS_W + 3)
+    M = load9(dw, n, DS_W + 6)
+    # S x* F = [s_w x n + s_v x f; s_w x f]
+    a = cross(S[0], S[1], S[2], F[0], F[1], F[2])
+    b = cross(S[3], S[4], S[5], F[3], F[4], F[5])
+    c = cross(S[0], S[1], S[2], F[3], F[4], F[5])
+    Mw = rot(M, S[0], S[1], S[2])
+    dn = cross(S[0], S[1], S[2], nw[0], nw[1], nw[2])
+    df = cross(S[0], S[1], S[2], fw[0], fw[1], fw[2])
+    y = (a[0] + b[0] + Mw[0] - dn[0], a[1] + b[1] + Mw[1] - dn[1],
+         a[2] + b[2] + Mw[2] - dn[2], c[0] - df[0], c[1] - df[1],
+         c[2] - df[2])
+    for r in range(6):
+        x = y[r]
+        for s in range(6):
+            x += (cw[n, CS_BC + 6 * r + s] * (Sd[s] + Sd[s])
+                  - cw[n, CS_IC + 6 * r + s] * C[s])
+        dw[j, DW_Y + r] = x
+    Mt = rot_t(M, S[0], S[1], S[2])
+    a = cross(nw[0], nw[1], nw[2], S[0], S[1], S[2])
+    b = cross(fw[0], fw[1], fw[2], S[3], S[4], S[5])
+    for r in range(3):
+        dw[j, DW_U + r] = Mt[r] - a[r] - b[r]
 
 
 @njit(cache=True, inline='always')
@@ -195,7 +295,7 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
     mimic = has_mimic(links, frames)
     joint_trig(links, frames, q, ws)
     coriolis_forward(links, frames, qd, ws, cw)
-    coriolis_backward(links, frames, cw)
+    coriolis_backward(links, frames, cw, cw, False)
     tree = branched(frames)
     if mimic or tree:
         zero_matrix(frames, C)

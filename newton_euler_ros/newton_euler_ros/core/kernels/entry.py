@@ -44,10 +44,11 @@ from ._jit import njit
 from .aba import articulated_body
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
+from .derivatives import aba_derivatives, rnea_derivatives
 from .generate import batch, entry
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_WIDTH, CW_WIDTH, F_ROWS, F_TREE, GRAVITY,  # noqa
-                     LINK_WRENCHES, NONFINITE, OVERFLOW, SINGULAR, SIZE,
+from .layout import (A_WIDTH, CW_WIDTH, DW_WIDTH, F_ROWS, F_TREE,  # noqa
+                     GRAVITY, LINK_WRENCHES, NONFINITE, OVERFLOW, SINGULAR, SIZE,
                      T_NQ, VELOCITY, W_WIDTH, WRENCH_BITS, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
                            mass_matrix_columns, momentum_terms, recursion)
@@ -55,7 +56,7 @@ from .regressor import drive_columns, regressor_columns
 from .status import (first_nonfinite, first_nonfinite_entry,  # noqa: F401
                      matrix_status)
 
-# A_WIDTH, CW_WIDTH, NONFINITE, SIZE and W_WIDTH are read by the generated
+# A_WIDTH, CW_WIDTH, DW_WIDTH, NONFINITE, SIZE and W_WIDTH are read by the generated
 # checks (generate.SHAPES), from this module's globals.
 
 
@@ -195,6 +196,60 @@ def regressor_row(links, frames, q, qd, qdd, drives, eps, ws, line, acc, Y):
     return -1
 
 
+@njit(cache=True)
+def inverse_dynamics_derivatives_row(links, frames, q, qd, qdd, wrench,
+                                     damping, flags, ws, cw, dw, dtau):
+    """dtau/dq, dtau/dqd into dtau[0], dtau[1] (``rnea_derivatives``)."""
+    return rnea_derivatives(links, frames, q, qd, qdd, wrench, dw, dw,
+                            (flags & GRAVITY) != 0,
+                            (flags >> WRENCH_SHIFT) & WRENCH_BITS, False,
+                            damping, ws, cw, dw, dtau[0], dtau[1])
+
+
+@njit(cache=True)
+def inverse_dynamics_derivatives_links_row(links, frames, q, qd, qdd, wrench,
+                                           fext, wext, damping, flags, ws,
+                                           cw, dw, dtau):
+    """Compute them with wrenches at links (``fext`` fixed, ``wext`` not)."""
+    return rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
+                            (flags & GRAVITY) != 0,
+                            (flags >> WRENCH_SHIFT) & WRENCH_BITS,
+                            (flags & LINK_WRENCHES) != 0, damping, ws, cw,
+                            dw, dtau[0], dtau[1])
+
+
+@njit(cache=True)
+def forward_dynamics_derivatives_row(links, frames, q, qd, tau, wrench,
+                                     armature, damping, flags, ws, cw, dw,
+                                     chol, scratch, dqdd):
+    """dqdd/dq, dqdd/dqd, dqdd/dtau into dqdd[0..2] (``aba_derivatives``)."""
+    return aba_derivatives(links, frames, q, qd, tau, wrench, dw, dw, dw,
+                           (flags & GRAVITY) != 0,
+                           (flags >> WRENCH_SHIFT) & WRENCH_BITS, False,
+                           armature, damping, ws, cw, dw, chol, scratch,
+                           dqdd[0], dqdd[1], dqdd[2])
+
+
+@njit(cache=True)
+def forward_dynamics_derivatives_links_row(links, frames, q, qd, tau, wrench,
+                                           fall, fext, wext, armature,
+                                           damping, flags, ws, cw, dw, chol,
+                                           scratch, dqdd):
+    """
+    Compute them with wrenches at links.
+
+    ``fall`` all in link axes (the bias torques), ``fext`` those fixed to
+    their link, ``wext`` those of fixed direction (the derivatives).
+    """
+    return aba_derivatives(links, frames, q, qd, tau, wrench, fall, fext,
+                           wext,
+                           (flags & GRAVITY) != 0,
+                           (flags >> WRENCH_SHIFT) & WRENCH_BITS,
+                           (flags & LINK_WRENCHES) != 0, armature, damping,
+                           ws, cw, dw, chol, scratch, dqdd[0], dqdd[1],
+                           dqdd[2])
+
+
 # ---------------------------------------------------------------------------
 # the registrations: one entry point (and batch loop) per row step
 
@@ -216,3 +271,13 @@ run_forward_dynamics_links = entry(forward_dynamics_links_row)
 run_jacobian = entry(jacobian_row)
 run_link_poses = entry(link_poses_row)
 run_regressor_batch = batch(regressor_row)
+run_inverse_dynamics_derivatives = entry(inverse_dynamics_derivatives_row)
+run_inverse_dynamics_derivatives_batch = batch(
+    inverse_dynamics_derivatives_row)
+run_inverse_dynamics_derivatives_links = entry(
+    inverse_dynamics_derivatives_links_row)
+run_forward_dynamics_derivatives = entry(forward_dynamics_derivatives_row)
+run_forward_dynamics_derivatives_batch = batch(
+    forward_dynamics_derivatives_row)
+run_forward_dynamics_derivatives_links = entry(
+    forward_dynamics_derivatives_links_row)

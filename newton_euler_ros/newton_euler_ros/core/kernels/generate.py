@@ -58,10 +58,16 @@ SHAPES = {
     'terms': ('3', 'n'),
     'line': ('>=nb', '6'), 'acc': ('>=10 * nb', '6'),
     'Y': ('n', '10 * nb + 4 * n if drives else 10 * nb'),
+    'wext': ('nb', '15'), 'fall': ('nb', '6'), 'dw': ('>=nb + 1', 'DW_WIDTH'),
+    'damping': ('n',), 'armature': ('n',), 'chol': ('n', 'n'),
+    'dtau': ('2', 'n', 'n'), 'dqdd': ('3', 'n', 'n'),
 }
 # input a of the status codes (``calling.INPUTS``, ``calling.FD_INPUTS``)
-INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3, 'fext': 4}
-WORKSPACES = ('ws', 'aw', 'cw', 'scratch', 'Ts', 'line', 'acc')
+INPUTS = {'q': 0, 'qd': 1, 'qdd': 2, 'tau': 2, 'wrench': 3, 'fext': 4,
+          'wext': 4, 'fall': 4}
+# sizes checked as a workspace's (SIZE + 5): scratch and per-joint constants
+WORKSPACES = ('ws', 'aw', 'cw', 'dw', 'scratch', 'Ts', 'line', 'acc', 'chol',
+              'damping', 'armature')
 
 SOURCES = {}    # name -> the generated source of each entry point
 

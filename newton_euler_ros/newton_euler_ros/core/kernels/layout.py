@@ -122,6 +122,23 @@ CS_IC = 0        # scratch row: composite inertia (36)
 CS_BC = 36       # composite Coriolis matrix (36)
 CS_H = 72        # I_j V_j (6)
 
+# ---- ``dw``: the derivative workspace (n + 1 rows) -------------------------
+# Spatial vectors in frame 0 about its origin, as in ``cw`` (derivatives.py).
+# Row n is scratch: the running composite wrench F (6) and world-fixed
+# wrench data W (15) at the columns DS_* below.
+DW_A = 0         # 6: spatial acceleration of link j, gravity as the base's
+DW_C = 6         # 6: c_j = S_j x A_lambda(j) + Sdot_j x V_lambda(j)
+DW_E = 12        # 6: [moment; force] link j exerts on its environment
+DW_W = 18        # 15: its part of fixed direction: n, f, then M (9,
+#                  row-major) = p f^T - (p . f) 1 at its point p
+DW_Y = 33        # 6: Y_j, what q_j does to the wrench joint j carries
+DW_U = 39        # 3: U_j, the fixed-direction wrenches' share for j's row
+DW_T = 42        # tau_j = S_j . F_j, joint j's component of its wrench
+DW_ACC = 43      # 21: F and W the children of a branch point carried back
+DW_WIDTH = 64
+DS_F = 0         # scratch row: composite wrench (6)
+DS_W = 6         # composite fixed-direction data (15)
+
 # ---- switches and status codes -------------------------------------------
 # Wrench modes: where the end-effector wrench's axes are.
 WRENCH_NONE = 0
