@@ -224,7 +224,7 @@ def _wrenches(model, wrenches, wrench_frame):
 
 def link_wrench_rows(model, q, wrenches, wrench_frame, ws):
     """
-    Return ``ws.fext``: the wrenches of a mapping as per-joint rows.
+    Return ``ws.fall``: the wrenches of a mapping as per-joint rows.
 
     ``wrenches`` maps frame names to [f; n] (N, N m) exerted by that frame
     on its environment, the moment about the frame's origin, in base axes
@@ -237,23 +237,7 @@ def link_wrench_rows(model, q, wrenches, wrench_frame, ws):
     base frame, from one pose pass).  A frame fixed to the base takes its
     wrench on the base: no joint torque.
     """
-    rows = ws.fext
-    rows[:] = 0.0
-    poses = None
-    for _, body, T, F, frame in _wrenches(model, wrenches, wrench_frame):
-        if body < 0:
-            continue
-        R, p = T[:3, :3], T[:3, 3]
-        if frame == 'link':
-            f, n = R @ F[:3], R @ F[3:]
-        else:
-            if poses is None:
-                poses = _poses_array(model, q, ws).copy()
-            Rj = poses[body + 1, :9].reshape(3, 3)
-            f, n = Rj.T @ F[:3], Rj.T @ F[3:]
-        rows[body, :3] += f
-        rows[body, 3:] += n + np.cross(p, f)
-    return rows
+    return derivative_wrench_rows(model, q, wrenches, wrench_frame, ws)[0]
 
 
 def derivative_wrench_rows(model, q, wrenches, wrench_frame, ws):

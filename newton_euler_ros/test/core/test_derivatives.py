@@ -43,8 +43,7 @@ from newton_euler_ros.core.errors import (DynamicsInputError,
 from newton_euler_ros.core.robot_file import RobotFileWarning
 import numpy as np
 import pytest
-from random_tree import random_tree_urdf
-from test_trees import BRANCHED, robot_path, torso
+from test_trees import BRANCHED, torso, urdf_path
 
 H = 1e-4
 
@@ -88,12 +87,7 @@ def state(model, seed, scale=1.0):
                          + [3, 11, 23])
 def test_derivatives_match_pinocchio(source, tmp_path):
     from newton_euler_tools.peers import PinocchioTree
-    if isinstance(source, int):
-        path = tmp_path / 'tree.urdf'
-        path.write_text(random_tree_urdf(source)[0])
-        path = str(path)
-    else:
-        path = robot_path(source)
+    path = urdf_path(source, tmp_path)
     model = quiet(path)
     peer = PinocchioTree(path, model)
     for seed in (1, 2):
@@ -163,12 +157,7 @@ def test_mimic_joints_and_wrenches_at_links_on_a_tree():
 
 @pytest.mark.parametrize('source', [BRANCHED[1][0], BRANCHED[4][0], 5, 8])
 def test_published_and_random_trees_with_mimic_joints(source, tmp_path):
-    if isinstance(source, int):
-        path = tmp_path / 'tree.urdf'
-        path.write_text(random_tree_urdf(source, mimic=3)[0])
-        model = quiet(str(path))
-    else:
-        model = quiet(robot_path(source))
+    model = quiet(urdf_path(source, tmp_path, mimic=3))
     q, qd, qdd, tau = state(model, 7, 0.5)
     check_central(model, q, qd, qdd, tau)
     tip = list(model.link_frames)[-1]

@@ -44,7 +44,7 @@ import numpy as np
 import pytest
 from random_tree import random_tree_urdf
 import reference_dynamics as ref
-from test_trees import BRANCHED, robot_path, torso
+from test_trees import BRANCHED, robot_path, torso, urdf_path
 
 EPS32 = float(np.finfo(np.float32).eps)
 
@@ -64,12 +64,7 @@ def rel(a, b):
                                     BRANCHED[5][0], 1, 4, 16])
 def test_regressor_on_trees_matches_pinocchio(source, tmp_path):
     from newton_euler_tools.peers import PinocchioTree
-    if isinstance(source, int):
-        path = tmp_path / 'tree.urdf'
-        path.write_text(random_tree_urdf(source)[0])
-        path = str(path)
-    else:
-        path = robot_path(source)
+    path = urdf_path(source, tmp_path)
     model = quiet(path)
     peer = PinocchioTree(path, model)
     rng = np.random.default_rng(7)

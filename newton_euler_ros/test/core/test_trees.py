@@ -83,6 +83,15 @@ def robot_path(relative):
     return example_robot_urdf(relative)
 
 
+def urdf_path(source, tmp_path, **kw):
+    """Return a published URDF's path, or a random tree's (seed ``source``)."""
+    if isinstance(source, int):
+        path = tmp_path / 'tree.urdf'
+        path.write_text(random_tree_urdf(source, **kw)[0])
+        return str(path)
+    return robot_path(source)
+
+
 def ours(model, q, qd, qdd, tau, links):
     out = {'tau': inverse_dynamics(model, q, qd, qdd),
            'D': mass_matrix(model, q), 'C': coriolis_matrix(model, q, qd),

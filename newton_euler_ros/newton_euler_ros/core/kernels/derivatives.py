@@ -196,7 +196,7 @@ def composite_pass(links, frames, q, qd, qdd, wrench, fext, wext, gravity_on,
     coriolis_backward(links, frames, cw, dw, True)
 
 
-@njit(cache=True, inline='always')
+@njit(cache=True)
 def rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
                      gravity_on, wrench_mode, link_wrenches, damping, ws, cw,
                      dw, DQ, DV):
@@ -206,7 +206,9 @@ def rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
     ``damping`` (n) is added to DV's diagonal: the drives' d tau/d qd
     (viscous friction and the slope of the smooth Coulomb term).  Cost:
     three O(nb) passes and about 60 multiply-adds per pair of joints on
-    one path.  Returns -1 or OVERFLOW.
+    one path.  Returns -1 or OVERFLOW.  Not inlined: both entry points
+    and both batch loops call the one compilation (numba compiles an
+    inlined kernel again into each caller, minutes for this one).
     """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
@@ -284,15 +286,20 @@ def ltl_factor(links, H):
 @njit(cache=True, inline='always')
 def ltl_solve(links, L, x):
     """Solve L^T L x = b in place (x holds b), L from ``ltl_factor``."""
-    n = L.shape[0]
-    for k in range(n - 1, -1, -1):      # L^T y = b, from the tip
+    for k in range(L.shape[0] - 1, -1, -1):      # L^T y = b, from the tip
         y = x[k] / L[k, k]
         x[k] = y
         i = parent(links, k)
         while i >= 0:
             x[i] -= L[k, i] * y
             i = parent(links, i)
-    for k in range(n):                  # L x = y, from the base
+    ltl_forward(links, L, x)
+
+
+@njit(cache=True, inline='always')
+def ltl_forward(links, L, x):
+    """Solve L x = y in place (x holds y), from the base."""
+    for k in range(L.shape[0]):
         acc = x[k]
         i = parent(links, k)
         while i >= 0:
@@ -324,13 +331,7 @@ def ltl_inverse_column(links, frames, L, k, x):
             x[i] -= L[m, i] * y
             i = parent(links, i)
         m = parent(links, m)
-    for m in range(n):
-        acc = x[m]
-        i = parent(links, m)
-        while i >= 0:
-            acc -= L[m, i] * x[i]
-            i = parent(links, i)
-        x[m] = acc / L[m, m]
+    ltl_forward(links, L, x)
 
 
 @njit(cache=True, inline='always')
@@ -355,7 +356,7 @@ def times_minus_inverse(frames, Minv, X, col):
             X[i, k] = col[i]
 
 
-@njit(cache=True, inline='always')
+@njit(cache=True)
 def aba_derivatives(links, frames, q, qd, tau, wrench, fall, fext, wext,
                     gravity_on, wrench_mode, link_wrenches, armature, damping,
                     ws, cw, dw, chol, scratch, DQ, DV, DT):
