@@ -21,7 +21,7 @@
     newton-euler dynamics ROBOT --states STATES.json
     newton-euler check ROBOT
     newton-euler urdf ROBOT [-o FILE]
-    newton-euler feedforward ROBOT TRAJECTORY.json [--wrench ...]
+    newton-euler feedforward ROBOT TRAJECTORY.json [--wrench ...] [--gains Q R]
     newton-euler robots
     newton-euler excite | identify | replay | payload | observe ...
     newton-euler send TRAJECTORY.json | record BAG   (on a live ROS graph)
@@ -346,6 +346,10 @@ def cmd_feedforward(args):
     if left:
         print(f'note: joints not in the trajectory held at 0, at rest: '
               f'{", ".join(left)}', file=sys.stderr)
+    if args.gains is not None:
+        from .cli_gains import add_gains
+        add_gains(model, filled, args.gains, wrench, frame, f'{path}: ',
+                  hold)
     print(json.dumps(filled))
     return 0
 
@@ -464,6 +468,12 @@ def build_parser():
                     'axes of --wrench (default base; end_effector: the '
                     "frame's own)")
     _chain_options(ff)
+    ff.add_argument('--gains', nargs=2, metavar=('Q', 'R'),
+                    help='also write the time-varying LQR gains K of tau = '
+                         'effort + K (x_ref - x), x = (q, qd), in each point'
+                         ' ("gains", n x 2n): Q is P,V (position and '
+                         'velocity weights) or 2n values, R one torque '
+                         'weight or n values, comma-separated')
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
