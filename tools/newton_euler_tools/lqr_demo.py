@@ -30,14 +30,20 @@ same robot.  Prints the RMS and peak position error and the peak
 feedback torque of each run, and the RMS error once the start's
 transient is over.  ``--quick``: 1 s instead of 2 s.
 """
+import os
 import time
 import warnings
 
-from newton_euler_ros.core import forward_dynamics, load_robot, mass_matrix
-from newton_euler_ros.core.lqr import trajectory_gains
-import numpy as np
+# small matrices: BLAS threads only contend (a 21 x 21 expm took 1.6 ms
+# with them on two loaded cores, 0.09 ms without); before numpy loads
+os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
-from .timing import quick_option
+from newton_euler_ros.core import (forward_dynamics, load_robot,  # noqa: E402
+                                   mass_matrix)
+from newton_euler_ros.core.lqr import trajectory_gains  # noqa: E402
+import numpy as np  # noqa: E402
+
+from .timing import quick_option  # noqa: E402
 
 ROBOT = 'panda'
 Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8])
