@@ -28,14 +28,14 @@ import json
 import os
 import warnings
 
-from newton_euler_ros.core import (Drives, forward_dynamics, load_robot,
-                                   robot_from_dict)
+from newton_euler_ros.core import Drives, forward_dynamics, load_robot
 from newton_euler_ros.core import lqr
 from newton_euler_ros.core.linearize import zero_order_hold
 from newton_euler_ros.core.lqr import LqrError, trajectory_gains
 from newton_euler_ros.core.trajectory import trajectory_efforts
 import numpy as np
 import pytest
+from test_linearize import pendulum
 
 MOVE = os.path.join(os.path.dirname(__file__), '..', '..', 'config',
                     'trajectories', 'puma560_move.json')
@@ -46,20 +46,6 @@ def puma():
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')     # the published inertias' note
         return load_robot('puma560')
-
-
-def pendulum():
-    """One revolute link of 1 m, 2 kg at its middle, gravity along -y."""
-    with warnings.catch_warnings():
-        warnings.simplefilter('ignore')
-        model, _ = robot_from_dict({
-            'name': 'pendulum', 'convention': 'standard',
-            'gravity': [0.0, -9.81, 0.0],
-            'links': [{'name': 'joint1', 'type': 'revolute', 'a': 1.0,
-                       'alpha': 0.0, 'd': 0.0, 'theta': 0.0, 'mass': 2.0,
-                       'com': [-0.5, 0.0, 0.0],
-                       'inertia': [1e-4, 1 / 6, 1 / 6, 0.0, 0.0, 0.0]}]})
-    return model
 
 
 def test_doctest():
