@@ -280,6 +280,32 @@ def _run_every_kernel(mod, model, dtype):
     assert mod.run_mass_matrix_batch(P, Q, ws, MM, status) == -1
     assert mod.run_gravity_torques_batch(P, Q, ws, TAU, status) == -1
     assert mod.run_coriolis_matrix_batch(P, Q, Q, ws, cw, MM, status) == -1
+    # the derivatives (kernels/derivatives.py), every wrench mode
+    dw = np.zeros((nb + 1, mod.DW_WIDTH), f)
+    wext = np.ones((nb, 15), f)
+    chol = np.zeros((n, n), f)
+    zn = np.zeros(n, f)
+    D2 = np.zeros((2, n, n), f)
+    D3 = np.zeros((3, n, n), f)
+    for mode in (mod.WRENCH_NONE, mod.WRENCH_BASE, mod.WRENCH_EE):
+        flags = mod.flags(True, True, mode)
+        assert mod.run_inverse_dynamics_derivatives(
+            P, q, q, q, w, zn, flags, ws, cw, dw, D2) == -1
+        assert mod.run_forward_dynamics_derivatives(
+            P, q, q, q, w, zn, zn, flags, ws, cw, dw, chol, scratch, D3) == -1
+        flags = mod.flags(True, True, mode, True)
+        assert mod.run_inverse_dynamics_derivatives_links(
+            P, q, q, q, w, fext, wext, zn, flags, ws, cw, dw, D2) == -1
+        assert mod.run_forward_dynamics_derivatives_links(
+            P, q, q, q, w, fext, fext, wext, zn, zn, flags, ws, cw, dw, chol,
+            scratch, D3) == -1
+    flags = mod.flags(True, True, mod.WRENCH_NONE)
+    assert mod.run_inverse_dynamics_derivatives_batch(
+        P, Q, Q, Q, W, zn, flags, ws, cw, dw, np.zeros((3, 2, n, n), f),
+        status) == -1
+    assert mod.run_forward_dynamics_derivatives_batch(
+        P, Q, Q, Q, W, zn, zn, flags, ws, cw, dw, chol, scratch,
+        np.zeros((3, 3, n, n), f), status) == -1
     YY = np.zeros((3, n, 10 * nb + 4 * n), f)
     assert mod.run_regressor_batch(P, Q, Q, Q, True, f(0.02), ws,
                                    np.zeros((nb, 6), f),
