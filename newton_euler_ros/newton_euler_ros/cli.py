@@ -270,7 +270,7 @@ def cmd_check(args):
 
 def cmd_simulate(args):
     from .sim.scene import load_scene
-    from .sim.simulate import simulate
+    from .sim.run import simulate
     scene = load_scene(args.scene)
     if args.engine is not None and args.engine != scene.engine:
         scene = _with_engine(scene, args.engine)

@@ -17,8 +17,8 @@ import dataclasses
 import math
 
 from newton_euler_ros.core import wrench_torques
-from newton_euler_ros.sim.simulate import (SceneDynamics, simulate,
-                                           tracking_controller)
+from newton_euler_ros.sim.run import simulate
+from newton_euler_ros.sim.simulate import SceneDynamics, tracking_controller
 from newton_euler_tools.accuracy import scenes as S
 import numpy as np
 import pytest

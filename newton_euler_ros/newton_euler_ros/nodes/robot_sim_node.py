@@ -95,7 +95,7 @@ def advance(dyn, q, qd, tau, t, period, dt, method, wrench_at=None):
     Advance (q, qd) by ``period`` of simulated time from ``t``.
 
     Sub-steps of at most ``dt`` with the scene's integrator, holding
-    ``tau`` (zero-order hold), as :func:`..sim.simulate.simulate` does;
+    ``tau`` (zero-order hold), as :func:`..sim.run.simulate` does;
     ``wrench_at(t) -> (wrench, frame)`` as for ``integrator_step``.
     Return the new (q, qd).
     """

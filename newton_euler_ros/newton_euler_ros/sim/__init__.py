@@ -18,5 +18,7 @@ Simulation on top of the core: scenes and their integration.
 ``scene`` reads and validates scene files (a robot, the effects present,
 a task); ``simulate`` holds :class:`~.simulate.SceneDynamics` (exactly a
 scene's effects, the wrench always an argument), the one integrator step
-and the offline simulator.  Nothing here imports ROS.
+and the builtin offline simulator; ``mujoco_model``, ``mujoco_plant`` and
+``mujoco_scene`` the MuJoCo plant; ``run.simulate`` runs a scene in the
+engine it names.  Nothing here imports ROS.
 """

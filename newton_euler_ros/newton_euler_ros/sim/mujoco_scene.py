@@ -220,7 +220,7 @@ def simulate_mujoco(scene, duration=None, controller=None, feedforward=None,
     """
     Simulate a scene in MuJoCo; return a SimulationResult.
 
-    As :func:`.simulate.simulate`: ``controller(t, q, qd) -> (tau,
+    As :func:`.simulate.simulate_builtin`: ``controller(t, q, qd) -> (tau,
     tau_ff)`` (default the scene's PD plus the library's feedforward) at
     every step, held over it.  The energy columns are the library's
     energy of MuJoCo's motion and the torques' work on it (friction,

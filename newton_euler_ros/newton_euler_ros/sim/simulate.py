@@ -217,24 +217,20 @@ def _close(bar):
         bar.close()
 
 
-def simulate(scene, duration=None, controller=None, feedforward=None,
-             integrator=None, step=None, progress=False,
-             feedforward_at='desired'):
+def simulate_builtin(scene, duration=None, controller=None,
+                     feedforward=None, integrator=None, step=None,
+                     progress=False, feedforward_at='desired'):
     """
-    Simulate a scene deterministically; return a SimulationResult.
+    Simulate a scene deterministically in this engine; a SimulationResult.
 
     ``controller(t, q, qd) -> (tau, tau_ff)`` defaults to
     :func:`tracking_controller` (with ``feedforward`` and
     ``feedforward_at``, 'desired' or 'measured'); torques are held
     constant over each step (as a digital controller would).
-    ``progress`` shows a progress bar.  A scene with ``engine: mujoco``
-    runs in MuJoCo (:func:`.mujoco_scene.simulate_mujoco`).
+    ``progress`` shows a progress bar.  Whatever the scene's ``engine``:
+    :func:`.run.simulate` chooses the engine a scene asks for.
     """
     check_feedforward_at(feedforward_at)
-    if scene.engine == 'mujoco':
-        from .mujoco_scene import simulate_mujoco
-        return simulate_mujoco(scene, duration, controller, feedforward,
-                               step, feedforward_at)
     dyn = SceneDynamics(scene)
     control = controller or tracking_controller(dyn, feedforward,
                                                 feedforward_at)

@@ -208,7 +208,7 @@ def test_bad_link_wrenches_are_one_line(wrench, frame, message):
 # ---------------------------------------------------------------------------
 def test_energy_is_conserved_simulating_a_tree(tmp_path):
     from newton_euler_ros.sim.scene import scene_from_dict
-    from newton_euler_ros.sim.simulate import simulate
+    from newton_euler_ros.sim.run import simulate
     path = tmp_path / 'tree.urdf'
     path.write_text(random_tree_urdf(11, links=9)[0])
     model = quiet(str(path))

@@ -292,7 +292,7 @@ def test_scene_controller_is_stable_sampled_at_its_rate(name):
     import dataclasses
 
     from newton_euler_tools.accuracy.scenes import held_controller
-    from newton_euler_ros.sim.simulate import simulate
+    from newton_euler_ros.sim.run import simulate
     scene = load_scene(name)
     for gain in (1.0, 1.5):
         sc = dataclasses.replace(scene, kp=gain * scene.kp,

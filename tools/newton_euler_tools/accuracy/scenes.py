@@ -45,9 +45,10 @@ from newton_euler_ros.core import (inverse_dynamics, inverse_dynamics_batch,
                                    Workspace)
 from newton_euler_ros.core.effects import friction_torque
 from newton_euler_ros.core.robot_file import RobotFileWarning
+from newton_euler_ros.sim.run import simulate
 from newton_euler_ros.sim.scene import INTEGRATORS, load_scene
 from newton_euler_ros.sim.simulate import (integrator_step, SceneDynamics,
-                                           simulate, tracking_controller)
+                                           tracking_controller)
 import numpy as np
 
 from ..bench import Timer
