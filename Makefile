@@ -52,7 +52,7 @@ setup:
 	@bash scripts/setup_env.sh
 
 test: setup
-	NEWTON_EULER_NO_SKIPS=1 $(PY) -m pytest -q -p no:cacheprovider $(PYTEST_WORKERS) $(PYTEST_ARGS)
+	NEWTON_EULER_NO_SKIPS=1 $(PY) -m pytest -q -p no:cacheprovider --durations=30 $(PYTEST_WORKERS) $(PYTEST_ARGS)
 
 demo: setup
 	$(PY) -m newton_euler_tools.demo
