@@ -27,18 +27,29 @@ model's joint order:
   list that the whole robot's merger (``whole_robot``) shares.
 
 Every rejection of an input message, here and in ``wrenches``,
-``whole_robot`` and ``feedforward``, raises :class:`InputRejected` with a
-one-line reason and a short ``kind`` used for counters.
+``whole_robot``, ``feedforward`` and the linearize service, raises
+:class:`InputRejected` with a one-line reason and a short ``kind``, one
+of :data:`REJECTIONS`: the node's counters (``/diagnostics``) are made
+from that list, so a kind cannot be raised without being counted.
 """
 import numpy as np
 
 from .core.text import clip
 
 
+#: why an input message is not used: each a counter in /diagnostics
+REJECTIONS = ('missing_joints', 'non_finite', 'malformed', 'unknown_frame',
+              'stale', 'no_state', 'implausible', 'oversized', 'bad_stamp',
+              'other_joints', 'mimic_mismatch')
+
+
 class InputRejected(Exception):
     """An input message cannot be used; ``kind`` names the counter."""
 
     def __init__(self, kind, message):
+        if kind not in REJECTIONS:      # a programming error, not input's
+            raise ValueError(f'InputRejected: unknown kind {kind!r} (not '
+                             f'in joint_inputs.REJECTIONS)')
         super().__init__(message)
         self.kind = kind
 

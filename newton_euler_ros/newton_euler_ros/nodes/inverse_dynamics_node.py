@@ -72,19 +72,17 @@ from ..core.text import clip
 from ..core.urdf import urdf_model
 from ..feedforward_build import (build_computer, check_payload,
                                  is_whole_robot, PAYLOAD)
-from ..joint_inputs import InputRejected
+from ..joint_inputs import InputRejected, REJECTIONS
 from ..parameters import load_specs
 from ..safety import BOUND_SOURCES, over_text, OverLimitLog
 from ..sim.scene import load_scene
 from ..wrenches import wrench_input
 
-COUNTERS = ('published', 'missing_joints', 'non_finite', 'malformed',
-            'unknown_frame', 'stale', 'expired', 'no_state',
-            'service_calls', 'service_failures', 'internal_error',
-            'no_model', 'descriptions_loaded', 'descriptions_rejected',
-            'trajectories', 'payload_changes', 'implausible', 'over_limit',
-            'oversized', 'bad_stamp', 'other_joints', 'mimic_mismatch',
-            'held')
+# the rejections' counters come from their one list (joint_inputs)
+COUNTERS = ('published',) + REJECTIONS + (
+    'expired', 'service_calls', 'service_failures', 'internal_error',
+    'no_model', 'descriptions_loaded', 'descriptions_rejected',
+    'trajectories', 'payload_changes', 'over_limit', 'held')
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,

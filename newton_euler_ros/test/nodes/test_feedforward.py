@@ -288,3 +288,39 @@ def test_the_torque_bound_warning_names_the_joints_once_per_change(puma):
         [12.0, 0, 9.0], [12.0, 0, 9.0], [0, 30.0, 0])]
     assert said == [True, False, False, False, True, False, True]
     assert joint_units(puma) == ['N m'] * 6
+
+
+def test_every_rejection_kind_raised_is_one_the_node_counts():
+    """Each InputRejected kind in the sources is in REJECTIONS, counted."""
+    import ast
+    import os
+    from newton_euler_ros import joint_inputs
+    from newton_euler_ros.nodes.inverse_dynamics_node import COUNTERS
+    package = os.path.dirname(joint_inputs.__file__)
+    raised = {}
+    for folder, _, files in os.walk(package):
+        for name in files:
+            if not name.endswith('.py'):
+                continue
+            path = os.path.join(folder, name)
+            with open(path, encoding='utf-8') as fh:
+                tree = ast.parse(fh.read())
+            for node in ast.walk(tree):
+                if isinstance(node, ast.Call) and getattr(
+                        node.func, 'id', None) == 'InputRejected':
+                    kind = node.args[0]
+                    kinds = [kind.body, kind.orelse] if isinstance(
+                        kind, ast.IfExp) else [kind]
+                    for k in kinds:
+                        assert isinstance(k, ast.Constant), (
+                            f'{path}:{node.lineno}: the kind must be a '
+                            f'literal (or a choice of two)')
+                        raised.setdefault(k.value, f'{path}:{node.lineno}')
+    assert len(raised) >= 8, raised         # the walk sees the raises
+    unknown = {k: where for k, where in raised.items()
+               if k not in joint_inputs.REJECTIONS}
+    assert not unknown, f'kinds not in joint_inputs.REJECTIONS: {unknown}'
+    assert set(joint_inputs.REJECTIONS) <= set(COUNTERS)
+    assert len(set(COUNTERS)) == len(COUNTERS)
+    with pytest.raises(ValueError, match='unknown kind'):
+        InputRejected('no_such_kind', 'text')
