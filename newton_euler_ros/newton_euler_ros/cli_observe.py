@@ -18,6 +18,8 @@
     newton-euler observe MODEL.urdf BAG --base LINK --tip LINK
                          [--csv OUT.csv] [--plot OUT.png] [--json]
                          [--topic T] [--gain K] [--thresholds T [T ...]]
+                         [--speed-thresholds B [B ...]]
+                         [--acceleration-thresholds C [C ...]]
                          [--static-friction R] [--no-rest-reference]
                          [--hysteresis H] [--damping L] [--max-gap S]
                          [--payload-mass M] [--payload-com X Y Z]
@@ -82,6 +84,14 @@ def register(subparsers):
                      metavar='T', help='contact threshold per joint in '
                      'chain order, or one for all (N m or N, also for a '
                      'current-sensing arm; default 10)')
+    obs.add_argument('--speed-thresholds', type=float, nargs='+',
+                     default=[0.0], metavar='B', help='per joint (or one '
+                     'for all), the threshold grows by B per rad/s (m/s) '
+                     "of the joint's speed (N m s/rad; default 0)")
+    obs.add_argument('--acceleration-thresholds', type=float, nargs='+',
+                     default=[0.0], metavar='C', help='per joint (or one '
+                     'for all), the threshold grows by C per rad/s^2 of '
+                     "the joint's acceleration (N m s^2/rad; default 0)")
     obs.add_argument('--static-friction', type=float, default=1.5,
                      metavar='R', help='at rest, allow for static friction '
                      "up to R x each joint's Coulomb friction (URDF "
@@ -159,18 +169,28 @@ def _setup(args):
     try:
         model = payload_model(model, args.payload_mass, args.payload_com,
                               [0.0] * 6)
-        if len(args.thresholds) not in (1, model.n):
-            raise ValueError(
-                f'--thresholds: give 1 or {model.n} values (chain order '
-                f'{list(model.joint_names)}), got {len(args.thresholds)}')
+        for name in ('thresholds', 'speed_thresholds',
+                     'acceleration_thresholds'):
+            given = getattr(args, name)
+            if len(given) not in (1, model.n):
+                raise ValueError(
+                    f'--{name.replace("_", "-")}: give 1 or {model.n} '
+                    f'values (chain order {list(model.joint_names)}), got '
+                    f'{len(given)}')
         obs = MomentumObserver(model, args.gain, max_gap=args.max_gap,
                                damping=args.damping,
                                thresholds=args.thresholds,
+                               speed_thresholds=args.speed_thresholds,
+                               acceleration_thresholds=(
+                                   args.acceleration_thresholds),
                                hysteresis=args.hysteresis,
                                rest_reference=args.rest_reference,
                                **drive_options(model, args.static_friction))
     except ValueError as exc:
-        raise _Usage(str(exc).replace('payload.', '--payload-')) from None
+        text = str(exc).replace('payload.', '--payload-')
+        for name in ('acceleration_thresholds', 'speed_thresholds'):
+            text = text.replace(f'{name}:', f'--{name.replace("_", "-")}:')
+        raise _Usage(text) from None
     return model, obs
 
 
@@ -210,7 +230,7 @@ def _observe(args):
     if args.csv:
         _atomic_write(args.csv, lambda fh: _write_csv(fh, rec, out, names))
     if args.plot:
-        _plot(args.plot, rec.stamps, names, out, obs.thresholds)
+        _plot(args.plot, rec.stamps, names, out, _thresholds(obs, out))
     summary = _summary(args, model, obs, rec, out)
     if args.json:
         print(json.dumps(summary))
@@ -282,7 +302,8 @@ def _intervals(t, flag):
 def _summary(args, model, obs, rec, out):
     """Return what the command found, as a dict (the --json object)."""
     from .core.observer import beyond_friction, suggest_thresholds
-    from .core.observer_thresholds import rest_changes
+    from .core.observer_thresholds import (rest_changes,
+                                           suggest_state_thresholds)
     t = out.t
     resting = (np.abs(rec.qd) < obs.friction_width).all(axis=1)
     constant = obs.torque_constant
@@ -302,6 +323,11 @@ def _summary(args, model, obs, rec, out):
         'rest_reference': bool(obs.rest_reference),
         'peak_rest_change': rest_changes(out).tolist(),
         'suggested_thresholds': suggest_thresholds(out).tolist(),
+        'speed_thresholds': obs.speed_thresholds.tolist(),
+        'acceleration_thresholds': obs.acceleration_thresholds.tolist(),
+        'suggested_state_thresholds': dict(zip(
+            ('thresholds', 'speed_thresholds', 'acceleration_thresholds'),
+            (x.tolist() for x in suggest_state_thresholds(out)))),
         'contacts': int(out.contacts),
         'contact_fraction': float(out.contact.mean()),
         'resting_fraction': float(resting.mean()),
@@ -342,9 +368,24 @@ def _table(s):
                  "change from the settled arm's rest value (the rest "
                  'reference); suggested = 2 x the larger (valid when the '
                  'recording is free motion, no contact)')
+    state = s['suggested_state_thresholds']
+    lines.append('or thresholds growing with speed and acceleration '
+                 '(suggested: --thresholds ' + ' '.join(
+                     f'{x:.3g}' for x in state['thresholds'])
+                 + ' --speed-thresholds ' + ' '.join(
+                     f'{x:.3g}' for x in state['speed_thresholds'])
+                 + ' --acceleration-thresholds ' + ' '.join(
+                     f'{x:.3g}' for x in state['acceleration_thresholds'])
+                 + ')')
     for note in s['notes']:
         lines.append(f'note: {note}')
     return lines
+
+
+def _thresholds(obs, out):
+    """Return (m, n): each sample's thresholds (speed and acceleration)."""
+    return (obs.thresholds + obs.speed_thresholds * out.speed
+            + obs.acceleration_thresholds * out.acceleration)
 
 
 def _plot(path, t, names, out, thresholds):
@@ -357,7 +398,7 @@ def _plot(path, t, names, out, thresholds):
     for j, name in enumerate(names):
         line, = ax.plot(t, out.residual[:, j], lw=0.8, label=name)
         # the contact test's bound: threshold + static friction allowance
-        bound = thresholds[j] + out.allowance[:, j]
+        bound = thresholds[:, j] + out.allowance[:, j]
         ax.plot(t, bound, color=line.get_color(), lw=0.5, ls=':')
         ax.plot(t, -bound, color=line.get_color(), lw=0.5, ls=':')
     ax.set_ylabel('external torque\n(N m or N)')

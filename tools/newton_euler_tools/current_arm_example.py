@@ -17,7 +17,7 @@ Recordings of a "real" current-sensing arm (a UR5), as its driver reports.
 
     python -m newton_euler_tools.current_arm_example OUT_DIR [--seed N]
         [--effort current|torque] [--seconds S] [--free N] [--pushes N]
-        [--rate HZ]
+        [--rate HZ] [--unmodelled S]
 
 A model of the recordings a UR5 gives through its ROS 2 driver with the
 default settings (``/joint_states`` effort = motor current, A), for the
@@ -111,6 +111,12 @@ BRISTLE = 5e-4            # rad of travel for friction to follow the motion
 REST_DRIFT = 0.05         # of F_s per sqrt(s), at rest
 CURRENT_NOISE = 0.03      # A RMS
 KNOWN_MASS = 2.8          # kg
+# what an identified model may lack, for ``unmodelled`` > 0 (times it):
+# friction growing with the square of the speed (a lubricant's churning,
+# stiffer when the arm is cold), N m s^2 / rad^2, and rotor and gear
+# inertia beyond the identified one, kg m^2
+QUADRATIC = (16.0, 18.0, 10.0, 1.6, 1.5, 1.2)
+HIDDEN_ARMATURE = (1.2, 1.2, 0.6, 0.08, 0.08, 0.08)
 PAYLOAD_COM = (0.004, -0.012, 0.045)                 # m, tool0 frame
 PAYLOAD_INERTIA = ((4.2e-3, 0.0, 0.0), (0.0, 4.6e-3, 0.0),
                    (0.0, 0.0, 3.1e-3))               # kg m^2 about the com
@@ -165,8 +171,15 @@ def _realistic_wrists(root, rng):
             i_el.set(k, repr(float(v)))
 
 
-def real_arm(seed=0):
-    """Return the :class:`RealArm` of ``seed`` (the published UR5 perturbed)."""
+def real_arm(seed=0, unmodelled=0.0):
+    """
+    Return the :class:`RealArm` of ``seed`` (the published UR5 perturbed).
+
+    ``unmodelled`` > 0: its drives also have ``unmodelled`` times
+    :data:`QUADRATIC` friction and :data:`HIDDEN_ARMATURE`, which the
+    identified model (``current_arm_model``) does not have: a model
+    whose error grows with speed and acceleration.
+    """
     from .ident_example import perturb_urdf
     rng = np.random.default_rng([seed, 27])
     with open(ur5_path(), encoding='utf-8') as f:
@@ -186,6 +199,9 @@ def real_arm(seed=0):
               'ripple': draw(RIPPLE), 'ripple_phase': rng.uniform(0, 6.3, 6),
               'stribeck_speed': STRIBECK_SPEED, 'bristle': BRISTLE}
     constants = draw(TORQUE_CONSTANTS, 0.03)
+    if unmodelled:
+        drives['quadratic'] = unmodelled * np.asarray(QUADRATIC)
+        drives['hidden_armature'] = unmodelled * np.asarray(HIDDEN_ARMATURE)
     return RealArm(truth, drives, constants, seed)
 
 
@@ -327,6 +343,9 @@ def record(arm, path, motion, rate=100.0, effort='current', payload=None,
     torque = (sim.torques(q, qd, qdd) + np.asarray(d['armature']) * qdd
               + np.asarray(d['viscous']) * qd + fric + np.asarray(d['offset'])
               + ripple - external)
+    if 'quadratic' in d:            # what the identified model lacks
+        torque += (np.asarray(d['quadratic']) * qd * np.abs(qd)
+                   + np.asarray(d['hidden_armature']) * qdd)
     current = torque / arm.constants
     measured = current + rng.normal(0.0, CURRENT_NOISE, current.shape)
     if effort == 'torque':
@@ -360,17 +379,18 @@ RUNS = ('excitation', 'validation', 'known_mass', 'free', 'rest', 'pushed')
 def make_example(out_dir, seed=0, effort='current', seconds=60.0,
                  validation_seconds=40.0, known_mass_seconds=None, free=3,
                  free_seconds=30.0, pushes=0, rate=100.0, storage='mcap',
-                 runs=RUNS):
+                 runs=RUNS, unmodelled=0.0):
     """
     Write the files the module docstring lists; return their paths.
 
     ``runs`` selects the recordings (names of :data:`RUNS`; 'free'
     writes ``free_1`` ... ``free_<free>``, 'pushed' a recording with
-    ``pushes`` pushes of 20-100 N on the tool when ``pushes`` > 0).
+    ``pushes`` pushes of 20-100 N on the tool when ``pushes`` > 0;
+    ``unmodelled``: as :func:`real_arm`).
     The paths dict has 'urdf', 'truth' and one key per recording.
     """
     os.makedirs(out_dir, exist_ok=True)
-    arm = real_arm(seed)
+    arm = real_arm(seed, unmodelled)
     paths = {'urdf': os.path.join(out_dir, 'ur5.urdf')}
     shutil.copyfile(ur5_path(), paths['urdf'])
     truth = arm.to_json()
@@ -424,10 +444,15 @@ def main(argv=None):
     parser.add_argument('--pushes', type=int, default=0, metavar='N',
                         help='also a recording with N pushes on the tool')
     parser.add_argument('--rate', type=float, default=100.0)
+    parser.add_argument('--unmodelled', type=float, default=0.0,
+                        metavar='S', help='S x friction in speed squared '
+                        'and rotor inertia the identified model lacks '
+                        '(default 0)')
     args = parser.parse_args(argv)
     paths = make_example(args.out_dir, seed=args.seed, effort=args.effort,
                          seconds=args.seconds, free=args.free,
-                         pushes=args.pushes, rate=args.rate)
+                         pushes=args.pushes, rate=args.rate,
+                         unmodelled=args.unmodelled)
     for key, value in paths.items():
         print(f'{key}: {value}')
     return 0

@@ -37,6 +37,7 @@ checks seed 0 with these functions.
 """
 import argparse
 import os
+import sys
 import tempfile
 import warnings
 
@@ -66,8 +67,13 @@ def recordings(seed, out_dir):
     return {'urdf': urdf, 'arm': arm, 'runs': runs, 'pushes': pushes}
 
 
-def observed(urdf, path, thresholds, rest_reference=True):
-    """Run the observer over a bag as ``observe`` does (in process)."""
+def observed(urdf, path, thresholds, rest_reference=True, speed=0.0,
+             acceleration=0.0):
+    """
+    Run the observer over a bag as ``observe`` does (in process).
+
+    ``speed``, ``acceleration``: its speed and acceleration thresholds.
+    """
     from newton_euler_ros.core import load_robot
     from newton_euler_ros.core.observer import (drive_options,
                                                 MomentumObserver,
@@ -79,6 +85,8 @@ def observed(urdf, path, thresholds, rest_reference=True):
     rec = read_joint_states(path, model.joint_names, '/joint_states')
     obs = MomentumObserver(model, 50.0, thresholds=thresholds,
                            rest_reference=rest_reference,
+                           speed_thresholds=speed,
+                           acceleration_thresholds=acceleration,
                            **drive_options(model))
     return rec, observe_recording(obs, rec.stamps, rec.q, rec.qd,
                                   rec.effort)
@@ -164,6 +172,106 @@ def evaluate(data, rest_reference=True):
             'soon': sum(r[2] is not None and r[2] <= 0.2 for r in rows)}
 
 
+UNMODELLED = 1.0    # the arm of --moving: current_arm_example.real_arm's
+
+
+def moving_recordings(seed, out_dir, unmodelled=UNMODELLED):
+    """
+    Write the recordings of the moving-arm targets; return them.
+
+    An arm whose identified model misses friction in speed squared and
+    some rotor inertia (``real_arm(seed, unmodelled)``): one free minute
+    with stops to fit the thresholds on (as :func:`recordings`'
+    ``free_1``), a held-out 40 s of point-to-point moves at full speed
+    with short stops and reversals (``validation``), five held poses
+    (``rest``), and the 10 pushes of ``pushed``.
+    """
+    from . import current_arm_example as example
+    from .current_arm_model import write_identified
+    from .current_arm_motions import (held_then_moving, holding,
+                                      point_to_point, random_pushes)
+    arm = example.real_arm(seed, unmodelled)
+    urdf = write_identified(os.path.join(out_dir, 'arm.urdf'), arm, seed)
+    motion = held_then_moving(seed + 7)
+    pushes = random_pushes(seed, motion.seconds, 10)
+    plan = {'free_1': (point_to_point(seed + 100, 60.0, dwell=(0.3, 2.5),
+                                      few=0.3, reverse=0.7), ()),
+            'validation': (point_to_point(seed + 50, 40.0), ()),
+            'rest': (holding(seed), ()), 'pushed': (motion, pushes)}
+    runs = {}
+    for k, (name, (motion, push)) in enumerate(plan.items()):
+        path = os.path.join(out_dir, name)
+        runs[name] = (path, example.record(arm, path, motion, pushes=push,
+                                           seed=seed * 1000 + 500 + k))
+    return {'urdf': urdf, 'arm': arm, 'runs': runs, 'pushes': pushes}
+
+
+def moving_evaluate(data, state=True):
+    """
+    Return the moving-arm targets of one seed, a dict of figures.
+
+    Thresholds fitted on ``free_1``: ``suggest_state_thresholds``
+    (``state``) or ``suggest_thresholds`` (one number per joint); then
+    contact episodes on the held-out ``validation`` and on the held
+    poses, and the pushes reported (resting / moving) and within 0.2 s
+    of their onset.
+    """
+    from newton_euler_ros.core.observer_thresholds import (
+        suggest_state_thresholds, suggest_thresholds)
+    _, out = observed(data['urdf'], data['runs']['free_1'][0], 10.0)
+    if state:
+        a, b, c = suggest_state_thresholds(out)
+    else:
+        a, b, c = suggest_thresholds(out), 0.0, 0.0
+    got = {'thresholds': [np.asarray(x).tolist() for x in (a, b, c)]}
+    for name in ('validation', 'rest'):
+        _, o = observed(data['urdf'], data['runs'][name][0], a, True, b, c)
+        got[name] = int(o.contacts)
+        got[name + '_share'] = float(o.contact.mean())
+    rec, o = observed(data['urdf'], data['runs']['pushed'][0], a, True, b, c)
+    rows, at_rest = pushes_felt(data, rec, o)
+    got.update(rows=rows, at_rest=at_rest,
+               felt={w: (sum(r[2] is not None for r in rows if r[1] == w),
+                         sum(r[1] == w for r in rows))
+                     for w in ('rest', 'move')},
+               soon=sum(r[2] is not None and r[2] <= 0.2 for r in rows))
+    return got
+
+
+def moving_main(seeds, out):
+    """Print the moving-arm targets per seed, one line per threshold kind."""
+    print('seed  thresholds         contact episodes:        pushes '
+          'reported: resting moving  within 0.2 s')
+    print('                         point-to-point  held')
+    total = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for seed in seeds:
+            folder = os.path.join(out or tmp, f'moving_{seed}')
+            os.makedirs(folder, exist_ok=True)
+            data = moving_recordings(seed, folder)
+            for state in (False, True):
+                e = moving_evaluate(data, state)
+                kind = 'a + b|qd| + c|qdd|' if state else 'one per joint'
+                t = total.setdefault(kind, [0] * 7)
+                for i, x in enumerate((e['validation'], e['rest'],
+                                       *e['felt']['rest'], *e['felt']['move'],
+                                       e['soon'])):
+                    t[i] += x
+                print(f'{seed:>4}  {kind:<19}{e["validation"]:>8}'
+                      f'{e["rest"]:>12}{"":16}{e["felt"]["rest"][0]:>2} of '
+                      f'{e["felt"]["rest"][1]:<3}{e["felt"]["move"][0]:>3} '
+                      f'of {e["felt"]["move"][1]:<3}{e["soon"]:>6} of 10')
+                if state:
+                    print('      (a, b, c) = ' + '; '.join(
+                        ' '.join(f'{v:.2g}' for v in x)
+                        for x in e['thresholds']))
+    for kind, t in total.items():
+        print(f'all   {kind:<19}{t[0]:>8}{t[1]:>12}{"":16}{t[2]:>2} of '
+              f'{t[3]:<3}{t[4]:>3} of {t[5]:<3}{t[6]:>6} of '
+              f'{10 * len(seeds)}')
+    return 0
+
+
 def _seeds(text):
     if '-' in text:
         a, b = text.split('-')
@@ -180,7 +288,15 @@ def main(argv=None):
                         help="seeds, 'A-B' or 'A,B,...' (default 0-8)")
     parser.add_argument('--out', default=None, help='folder for the '
                         'recordings (default: a temporary one)')
+    parser.add_argument('--moving', action='store_true',
+                        help='the moving-arm targets instead: an arm whose '
+                        'model errs in proportion to speed and '
+                        'acceleration, thresholds one per joint against '
+                        'a + b|qd| + c|qdd| (default seeds 0-2)')
     args = parser.parse_args(argv)
+    if args.moving:
+        return moving_main(args.seeds if '--seeds' in ' '.join(
+            argv or sys.argv) else [0, 1, 2], args.out)
     total = {True: [0, 0, []], False: [0, 0, []]}
     late = []
     print('seed  pushes within 0.2 s of onset   free recordings with '

@@ -232,6 +232,9 @@ class MomentumObserver:
     thresholds : per-joint contact thresholds on |r| (N m or N), one
         value or one per joint (model order), on top of the static
         friction allowance.
+    speed_thresholds, acceleration_thresholds : per joint (>= 0), the
+        threshold's growth per rad/s of the joint's speed and per rad/s^2
+        of its acceleration (``observer_motion.py``); 0: constant.
     hysteresis : a joint in contact is released when |r| falls below
         this fraction of its threshold, plus the allowance
         (0 < hysteresis <= 1).
@@ -247,6 +250,7 @@ class MomentumObserver:
                  armature=None, damping=0.01, thresholds=10.0,
                  hysteresis=0.5, torque_constant=None, static_friction=None,
                  friction_width=DEFAULT_COULOMB_WIDTH, rest_reference=True,
+                 speed_thresholds=0.0, acceleration_thresholds=0.0,
                  ws=None):
         n = model.n
         self.model = model
@@ -285,6 +289,10 @@ class MomentumObserver:
             raise ValueError(f'damping: must be finite and >= 0, got '
                              f'{damping!r}')
         self.thresholds = _per_joint('thresholds', thresholds, n)
+        self.speed_thresholds = _per_joint('speed_thresholds',
+                                           speed_thresholds, n, False)
+        self.acceleration_thresholds = _per_joint(
+            'acceleration_thresholds', acceleration_thresholds, n, False)
         self.hysteresis = float(hysteresis)
         if not (0.0 < self.hysteresis <= 1.0):
             raise ValueError(f'hysteresis: must be in (0, 1], got '
@@ -298,6 +306,12 @@ class MomentumObserver:
         self._A = np.zeros((min(n, 6), min(n, 6)))
         self._y = np.zeros(min(n, 6))
         self._packed = model.packed
+
+    @property
+    def moving_thresholds(self):
+        """Whether a threshold grows with speed or acceleration."""
+        return bool(self.speed_thresholds.any()
+                    or self.acceleration_thresholds.any())
 
     def warm_up(self):
         """Compile (or load) every kernel once, before the first sample."""
@@ -498,6 +512,8 @@ class ObserverRecording:
     qd: np.ndarray = None           # (m, n) (``suggest_thresholds``)
     rest_reference: bool = False    # whether its contact test was on
     max_gap: float = 0.1
+    speed: np.ndarray = None        # (m, n) lagged |qd|, |qdd|
+    acceleration: np.ndarray = None  # (``observer_motion.py``)
 
 
 def observe_recording(obs, T, Q, QD, TAU):
@@ -523,7 +539,8 @@ def observe_recording(obs, T, Q, QD, TAU):
                             np.zeros(m, dtype=np.bool_), [],
                             allowance=np.zeros((m, n)), q=Q, qd=QD,
                             rest_reference=obs.rest_reference,
-                            max_gap=obs.max_gap)
+                            max_gap=obs.max_gap, speed=np.zeros((m, n)),
+                            acceleration=np.zeros((m, n)))
     state, contact = initial_state(obs), initial_contact(obs)
     F = np.zeros(6)
     for k in range(m):
@@ -540,6 +557,8 @@ def observe_recording(obs, T, Q, QD, TAU):
         out.allowance[k] = state.allowance
         out.wrench[k] = F
         out.contact[k] = contact.in_contact
+        out.speed[k] = contact.motion.speed
+        out.acceleration[k] = contact.motion.acceleration
         out.status.append(what)
     out.contacts = contact.count
     out.restarts = state.restarts

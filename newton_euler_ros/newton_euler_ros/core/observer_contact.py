@@ -57,6 +57,7 @@ from numba import njit
 import numpy as np
 
 from .kernels._jit import ENTRY
+from .observer_motion import motion_step, MotionState, state_thresholds
 
 #: rad/s (m/s): every joint slower than this for the arm to rest
 REST_SPEED = 0.01
@@ -208,14 +209,16 @@ def rest_deviations(T, Q, QD, R, thresholds, max_gap):
     Per sample, its smallest value over the last ``CONFIRM`` seconds (0
     where the test is off), over a recording taken as free of contact:
     what the test compares with the thresholds, for suggesting them.
+    ``thresholds``: (n,), or (m, n) one row per sample.
     """
     m, n = R.shape
+    thr = np.broadcast_to(np.asarray(thresholds, dtype=np.float64), (m, n))
     state = RestState(n)
     band = np.zeros(n, dtype=np.bool_)
     dev = np.zeros((m, n))
     armed = np.zeros(m, dtype=np.bool_)
     for k in range(m):
-        rest_step(state, T[k], Q[k], QD[k], R[k], thresholds, 1.0, max_gap,
+        rest_step(state, T[k], Q[k], QD[k], R[k], thr[k], 1.0, max_gap,
                   band, measure=True)
         armed[k] = state.armed
         dev[k] = state.deviation
@@ -256,12 +259,16 @@ class ContactState:
     in_contact: bool = False
     count: int = 0          # contacts begun (false -> true)
     rest: RestState = None  # the rest reference (its own flags)
+    # the lagged speeds and accelerations (``observer_motion.py``)
+    motion: MotionState = None
+    threshold: np.ndarray = None    # per joint, the last sample's
 
 
 def initial_contact(obs):
     """Return a contact state with no joint in contact."""
     return ContactState(np.zeros(obs.n, dtype=np.bool_),
-                        rest=RestState(obs.n))
+                        rest=RestState(obs.n), motion=MotionState(obs.n),
+                        threshold=obs.thresholds.copy())
 
 
 def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
@@ -272,15 +279,23 @@ def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
     (``state.allowance``), added to every threshold; None: none.  With
     the sample's stamp ``t`` (s), ``q`` and ``qd`` (model order), and the
     observer's ``rest_reference`` on, a joint is also in contact by the
-    rest reference's test (``observer_contact.py``).
+    rest reference's test (``observer_contact.py``).  With ``t`` and
+    ``qd``, each threshold grows with the joint's speed and acceleration
+    by the observer's ``speed_thresholds`` and
+    ``acceleration_thresholds`` (``observer_motion.py``; the thresholds
+    alone without them, or without ``t``).
     """
     if allowance is None:
         allowance = obs._no_allowance
-    now = _contact(r, obs.thresholds, obs.hysteresis, allowance,
-                   contact.active)
+    thr = obs.thresholds
+    if contact.motion is not None and t is not None and qd is not None:
+        motion_step(obs, contact.motion, t, qd)
+        if obs.moving_thresholds:
+            thr = state_thresholds(obs, contact.motion, contact.threshold)
+    now = _contact(r, thr, obs.hysteresis, allowance, contact.active)
     if t is not None and obs.rest_reference and contact.rest is not None:
-        now |= rest_step(contact.rest, t, q, qd, r, obs.thresholds,
-                         obs.hysteresis, obs.max_gap, contact.active)
+        now |= rest_step(contact.rest, t, q, qd, r, thr, obs.hysteresis,
+                         obs.max_gap, contact.active)
     if now and not contact.in_contact:
         contact.count += 1
     contact.in_contact = bool(now)

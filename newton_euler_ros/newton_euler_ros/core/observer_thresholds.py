@@ -57,22 +57,78 @@ def suggest_thresholds(recording, factor=FACTOR):
                             for x in rest])
 
 
-def rest_changes(recording, factor=FACTOR):
+def suggest_state_thresholds(recording, factor=FACTOR):
+    """
+    Return per-joint ``(a, b, c)`` (3 arrays (n,)) from a free recording.
+
+    The threshold ``a + b s + c u`` of ``observer_motion.py`` (``s``,
+    ``u``: the lagged speed and acceleration the recording carries)
+    that is smallest on average over the recording's samples while
+    lying above ``|r|`` beyond the static friction allowance at every
+    one of them (a linear program per joint, ``a, b, c >= 0``), times
+    ``factor``, each rounded up to two digits.  ``a`` is at least the
+    rest reference's :func:`rest_changes` times ``factor`` (0.1 at
+    least), as :func:`suggest_thresholds`, run with these thresholds.
+    With the recording at rest
+    throughout, ``b = c = 0``.
+    """
+    beyond = beyond_friction(recording)
+    n = beyond.shape[1]
+    a, b, c = np.zeros(n), np.zeros(n), np.zeros(n)
+    for j in range(n):
+        a[j], b[j], c[j] = _envelope(beyond[:, j], recording.speed[:, j],
+                                     recording.acceleration[:, j])
+    a = np.array([_round_up(factor * x) for x in a])
+    b = np.array([_round_up(factor * x, 0.0) for x in b])
+    c = np.array([_round_up(factor * x, 0.0) for x in c])
+    # the rest reference's test and its calm test, with the thresholds
+    # it will have at each sample (a larger a arms it sooner: again)
+    for _ in range(2):
+        thr = a + b * recording.speed + c * recording.acceleration
+        rest = rest_changes(recording, factor, thr)
+        a = np.maximum(a, [_round_up(factor * x) if x > 0.0 else 0.0
+                           for x in rest])
+    return a, b, c
+
+
+def _envelope(y, s, u):
+    """Smallest mean a + b s + c u (a, b, c >= 0) above y at every sample."""
+    from scipy.optimize import linprog     # on demand: scipy loads slowly
+    keep = y > 0.0
+    if not keep.any():
+        return 0.0, 0.0, 0.0
+    # scaled to comparable columns; only samples with y > 0 constrain
+    scale = np.array([1.0, max(s.max(), 1e-9), max(u.max(), 1e-9)])
+    X = np.column_stack([np.ones(y.size), s, u]) / scale
+    res = linprog(X.mean(axis=0), A_ub=-X[keep], b_ub=-y[keep],
+                  bounds=[(0.0, None)] * 3, method='highs')
+    if res.status != 0:          # cannot happen: a = max(y) is feasible
+        return float(y.max()), 0.0, 0.0
+    x = res.x / scale
+    # the solver's tolerance: lift a to cover every sample exactly
+    lack = float(np.max(y - np.column_stack([np.ones(y.size), s, u]) @ x))
+    return float(x[0] + max(lack, 0.0)), float(x[1]), float(x[2])
+
+
+def rest_changes(recording, factor=FACTOR, thresholds=None):
     """
     Return per joint the largest change from the rest value (n,).
 
     What the rest reference's test compares with the thresholds
     (:func:`.observer_contact.rest_deviations`, a change held for its
     confirmation time), run with the thresholds the allowance test
-    alone suggests (its calm test depends on them); zeros when the
-    recording's observer had the rest reference off.
+    alone suggests (its calm test depends on them), or with
+    ``thresholds`` ((n,) or one row per sample); zeros when the recording's observer had the rest
+    reference off.
     """
     n = recording.residual.shape[1]
     if not recording.rest_reference or recording.q is None:
         return np.zeros(n)
     held = rest_deviations(recording.t, recording.q, recording.qd,
                            recording.residual,
-                           _band_thresholds(recording, factor),
+                           _band_thresholds(recording, factor)
+                           if thresholds is None else
+                           np.asarray(thresholds, dtype=np.float64),
                            recording.max_gap)
     return held.max(axis=0, initial=0.0)
 
@@ -82,8 +138,8 @@ def _band_thresholds(recording, factor):
     return np.array([_round_up(factor * x) for x in peak])
 
 
-def _round_up(x):
+def _round_up(x, least=0.1):
     if not x > 0.0:
-        return 0.1
+        return least
     scale = 10.0 ** (math.floor(math.log10(x)) - 1)
-    return max(0.1, round(math.ceil(x / scale - 1e-9) * scale, 12))
+    return max(least, round(math.ceil(x / scale - 1e-9) * scale, 12))

@@ -124,6 +124,12 @@ class NodeObserver:
             damping=p['observer.damping'],
             thresholds=_per_joint('observer.thresholds',
                                   p['observer.thresholds'], model),
+            speed_thresholds=_per_joint('observer.speed_thresholds',
+                                        p['observer.speed_thresholds'],
+                                        model),
+            acceleration_thresholds=_per_joint(
+                'observer.acceleration_thresholds',
+                p['observer.acceleration_thresholds'], model),
             hysteresis=_at_most_one(p['observer.hysteresis']),
             rest_reference=p['observer.rest_reference'], **options)
         if obs.torque_constant is not None and 'constants' not in self.said:

@@ -1,0 +1,186 @@
+# Copyright 2026 newton_euler_ros developers
+#
+# Licensed under the Apache License, Version 2.0 (the "License");
+# you may not use this file except in compliance with the License.
+# You may obtain a copy of the License at
+#
+#     http://www.apache.org/licenses/LICENSE-2.0
+#
+# Unless required by applicable law or agreed to in writing, software
+# distributed under the License is distributed on an "AS IS" BASIS,
+# WITHOUT WARRANTIES OR CONDITIONS OF ANY KIND, either express or implied.
+# See the License for the specific language governing permissions and
+# limitations under the License.
+
+"""
+Contact thresholds that grow with speed and acceleration (issue 37).
+
+On the current-sensing example arm whose identified model misses
+friction in speed squared and some rotor inertia (its error grows with
+speed and acceleration): thresholds ``a + b |qd| + c |qdd|`` fitted on
+one free recording give no contact on another free motion and feel the
+pushes while the arm moves; ``b = c = 0`` is the constant threshold
+exactly; bad parameters are one-line errors.
+"""
+import os
+import subprocess
+import sys
+import warnings
+
+from newton_euler_ros.core import load_robot
+from newton_euler_ros.core.observer import (drive_options, MomentumObserver,
+                                            observe_recording)
+from newton_euler_ros.core.observer_thresholds import (
+    suggest_state_thresholds, suggest_thresholds)
+import numpy as np
+import pytest
+
+ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), '..', '..',
+                                    '..'))
+sys.path.insert(0, os.path.join(ROOT, 'tools'))
+
+
+@pytest.fixture(scope='module')
+def arm(tmp_path_factory):
+    """Record the arm: its identified URDF and three 20-40 s recordings."""
+    from newton_euler_tools import current_arm_example as example
+    from newton_euler_tools.current_arm_model import write_identified
+    from newton_euler_tools.current_arm_motions import (
+        held_then_moving, point_to_point, random_pushes)
+    from newton_euler_ros.ident.bag import read_joint_states
+    out = str(tmp_path_factory.mktemp('moving'))
+    real = example.real_arm(0, 1.0)
+    urdf = write_identified(os.path.join(out, 'arm.urdf'), real, 0)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_robot(urdf, base='base_link', tip='tool0')
+    motion = held_then_moving(7)
+    pushes = random_pushes(0, motion.seconds, 10)
+    plan = {'fit': (point_to_point(100, 40.0, dwell=(0.3, 2.5), few=0.3,
+                                   reverse=0.7), ()),
+            'held_out': (point_to_point(50, 25.0), ()),
+            'pushed': (motion, pushes)}
+    recs = {}
+    for k, (name, (m, push)) in enumerate(plan.items()):
+        path = os.path.join(out, name)
+        truth = example.record(real, path, m, pushes=push, seed=500 + k)
+        recs[name] = (read_joint_states(path, model.joint_names,
+                                        '/joint_states'), truth)
+    return {'model': model, 'recs': recs, 'pushes': pushes, 'urdf': urdf,
+            'dir': out}
+
+
+def _observe(arm, name, **kw):
+    model = arm['model']
+    rec = arm['recs'][name][0]
+    obs = MomentumObserver(model, 50.0, **kw, **drive_options(model))
+    return observe_recording(obs, rec.stamps, rec.q, rec.qd, rec.effort)
+
+
+@pytest.fixture(scope='module')
+def fitted(arm):
+    return suggest_state_thresholds(_observe(arm, 'fit', thresholds=10.0))
+
+
+def test_fitted_thresholds_keep_a_held_out_motion_free(arm, fitted):
+    a, b, c = fitted
+    assert (b > 0).any() and (a > 0).all() and (c >= 0).all()
+    out = _observe(arm, 'held_out', thresholds=a, speed_thresholds=b,
+                   acceleration_thresholds=c)
+    assert out.contacts == 0
+    # the model's error in fast motion: one number per joint from the
+    # same recording is far above a (what a push at rest must exceed)
+    constant = suggest_thresholds(_observe(arm, 'fit', thresholds=10.0))
+    assert (constant[:3] > 2.0 * a[:3]).all()
+
+
+def _felt(arm, out):
+    """Per push: whether it was reported while on, and the arm moving."""
+    rec, truth = arm['recs']['pushed']
+    t = (rec.stamps_ns - rec.stamps_ns[0]) * 1e-9
+    i = np.clip(np.searchsorted(truth['t'], t - 1e-6), 0,
+                len(truth['t']) - 1)
+    moving = (truth['qd'][i] != 0.0).any(axis=1)
+    rows = []
+    for p in arm['pushes']:
+        on = (t >= p['start']) & (t <= p['start'] + p['duration'])
+        rows.append((bool((out.contact & on).any()), bool(moving[on].any())))
+    return rows
+
+
+def test_fitted_thresholds_feel_the_pushes_on_the_moving_arm(arm, fitted):
+    a, b, c = fitted
+    out = _observe(arm, 'pushed', thresholds=a, speed_thresholds=b,
+                   acceleration_thresholds=c)
+    rows = _felt(arm, out)
+    assert sum(m for _, m in rows) >= 4           # pushes on the moving arm
+    assert all(felt for felt, _ in rows)
+    # one contact per push: no false one between them
+    assert out.contacts == len(rows)
+    constant = suggest_thresholds(_observe(arm, 'fit', thresholds=10.0))
+    old = _felt(arm, _observe(arm, 'pushed', thresholds=constant))
+    assert sum(f for f, _ in old) < len(rows)
+
+
+def test_zero_speed_and_acceleration_thresholds_are_the_constant_ones(arm):
+    thr = [5.0, 9.0, 4.0, 1.5, 1.0, 1.0]
+    old = _observe(arm, 'pushed', thresholds=thr)
+    new = _observe(arm, 'pushed', thresholds=thr, speed_thresholds=0.0,
+                   acceleration_thresholds=[0.0] * 6)
+    assert np.array_equal(old.contact, new.contact)
+    assert np.array_equal(old.residual, new.residual)
+    assert old.contacts == new.contacts > 0
+    # and a threshold growing with speed only ever reports less
+    more = _observe(arm, 'pushed', thresholds=thr, speed_thresholds=5.0)
+    assert not (more.contact & ~old.contact).any()
+
+
+def test_the_lagged_speed_bounds_a_residual_of_an_error_in_speed():
+    """A residual of an error e <= b |qd| stays below b s: the lag's bound."""
+    model = load_robot('panda')
+    n = model.n
+    obs = MomentumObserver(model, 50.0, thresholds=1e-3,
+                           speed_thresholds=1.0, rest_reference=False)
+    from newton_euler_ros.core.dynamics import inverse_dynamics
+    rng = np.random.default_rng(3)
+    t = np.cumsum(rng.uniform(0.004, 0.012, 800))
+    w = rng.uniform(1.0, 4.0, n)
+    Q = 0.3 * np.sin(w * t[:, None])
+    QD = 0.3 * w * np.cos(w * t[:, None])
+    QDD = -0.3 * w * w * np.sin(w * t[:, None])
+    # the drives lose 0.9 |qd| sign(qd) to a friction the model lacks:
+    # it looks like an external torque of at most 0.9 |qd|
+    TAU = np.array([inverse_dynamics(model, Q[k], QD[k], QDD[k])
+                    for k in range(t.size)]) + 0.9 * QD
+    out = observe_recording(obs, t, Q, QD, TAU)
+    thr = obs.thresholds + obs.speed_thresholds * out.speed
+    assert (np.abs(out.residual[50:]) < thr[50:]).all()
+    assert out.contacts == 0
+
+
+@pytest.mark.parametrize('kw, says', [
+    ({'speed_thresholds': -1.0}, 'speed_thresholds: must be finite'),
+    ({'acceleration_thresholds': float('nan')},
+     'acceleration_thresholds: must be finite'),
+    ({'speed_thresholds': [1.0, 2.0]}, 'speed_thresholds: must have 1 or 7'),
+])
+def test_bad_parameters_are_one_line_errors(kw, says):
+    with pytest.raises(ValueError) as err:
+        MomentumObserver(load_robot('panda'), 50.0, **kw)
+    assert says in str(err.value) and '\n' not in str(err.value)
+
+
+@pytest.mark.parametrize('args, says', [
+    (['--speed-thresholds', '-1'], '--speed-thresholds: must be finite'),
+    (['--acceleration-thresholds', 'nan'],
+     '--acceleration-thresholds: must be finite'),
+    (['--speed-thresholds', '1', '2'], '--speed-thresholds: give 1 or 6'),
+])
+def test_observe_says_bad_thresholds_in_one_line(arm, args, says):
+    cmd = [os.path.join(ROOT, '.venv', 'bin', 'newton-euler'), 'observe',
+           arm['urdf'], os.path.join(arm['dir'], 'held_out'), '--base',
+           'base_link', '--tip', 'tool0'] + args
+    done = subprocess.run(cmd, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and says in lines[0], done.stderr
