@@ -149,8 +149,6 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
                 al = load3(ws, par, W_X + 6)
                 ae = load3(ws, par, W_X + 9)
         R, p = placement(links, frames, j, ws)
-        qdj = joint_rate(links, qd, j, mimic)
-        vj = joint_rate(links, v, j, mimic)
         qddj = joint_rate(links, qdd, j, mimic)
         # acceleration of the new origin O_j, still in the parent's axes
         t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
@@ -164,6 +162,9 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
         al = rot_t(R, al[0], al[1], al[2])
         is_revolute = revolute(links, frames, j)
         if velocity_on:
+            # qd and v are read only here: gravity passes none
+            qdj = joint_rate(links, qd, j, mimic)
+            vj = joint_rate(links, v, j, mimic)
             w = rot_t(R, w[0], w[1], w[2])
             r = rot_t(R, r[0], r[1], r[2])
             if is_revolute:
@@ -319,13 +320,16 @@ def tip_wrench(frames, wrench, wrench_mode, Racc):
 @njit(cache=True, inline='always')
 def gravity(links, frames, q, ws, tau):
     """g(q) into tau: the recursion at rest with gravity only."""
-    unused = frames[0, :6]      # velocities and wrench: not read here
+    # tau, zeroed, serves as qdd (and as the velocities, which the
+    # recursion does not read with velocity_on False): the forward pass
+    # reads it before the backward pass writes the torques into it.  The
+    # wrench (6,) and the link wrenches (the workspace) are not read
+    # either (WRENCH_NONE, no link wrenches); every argument has its
+    # declared size all the same, so bounds checking finds nothing.
     joint_trig(links, frames, q, ws)
-    # tau, zeroed, serves as qdd: the forward pass reads it before the
-    # backward pass writes the torques into it
     for j in range(tau.shape[0]):
         tau[j] = frames[F_CONST, C_ZERO]
-    recursion(links, frames, unused, unused, tau, unused, ws, True, False,
+    recursion(links, frames, tau, tau, tau, frames[0, :6], ws, True, False,
               WRENCH_NONE, False, ws, tau)
 
 
