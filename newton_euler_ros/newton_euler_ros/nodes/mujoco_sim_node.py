@@ -56,6 +56,13 @@ axes and point of the momentum observer's estimate);
 model's root body is turned.  The tick a link leaves contact it gets one
 zero wrench, so that a reader's last value is right.
 
+Sensor noise: ``noise.position``, ``noise.velocity`` and
+``noise.effort`` are the standard deviations of Gaussian noise added to
+what joint_states carries for the commanded joints, drawn every tick
+from a generator seeded with ``noise.seed``, as a driver's encoders,
+velocity estimate and torque readings have it; the plant itself is
+not touched.  All zero (the default): MuJoCo's state exactly.
+
 Subscribes
     effort_controller/commands (std_msgs/Float64MultiArray: one effort
     per joint of ``joints``, N m or N; what ros2_control's effort forward
@@ -187,6 +194,10 @@ class MujocoSimNode(SharedGraphNode):
         self.achieved = float('nan')
         self.in_contact = set()
         self.contact_pubs = {}
+        # the sensors' noise: standard deviations, None when all zero
+        sigma = [p[f'noise.{k}'] for k in ('position', 'velocity', 'effort')]
+        self.noise = sigma if any(sigma) else None
+        self._rng = np.random.default_rng(p['noise.seed'])
 
         qos = qos_profile(100, 'reliable')
         self.state_pub = self.create_publisher(JointState, 'joint_states',
@@ -264,6 +275,10 @@ class MujocoSimNode(SharedGraphNode):
         log(f'rate: {1.0 / self.period:g} Hz of simulated time, real-time '
             f'factor {self.rtf:g}'
             + (' (as fast as it can)' if self.rtf == 0.0 else ''))
+        if self.noise is not None:
+            log('sensor noise (standard deviations): position '
+                f'{self.noise[0]:g}, velocity {self.noise[1]:g}, effort '
+                f'{self.noise[2]:g}; seed {self.params["noise.seed"]}')
         for note in robot.notes:
             log(f'note: {note}')
         log('holding the initial pose (brakes on) until the first command '
@@ -382,6 +397,8 @@ class MujocoSimNode(SharedGraphNode):
                            self.scene.wrench.at(plant.time))
         q, qd = plant.state()
         effort = self._zero if plant.held else plant.applied()
+        if self.noise is not None:
+            q, qd, effort = self._sensed(q, qd, effort)
         msg = self._state
         msg.header.stamp = now
         if self._follow_q.size:
@@ -396,6 +413,13 @@ class MujocoSimNode(SharedGraphNode):
         self.state_pub.publish(msg)
         if plant.data.ncon or self.in_contact:
             self._publish_contacts(plant, now)
+
+    def _sensed(self, q, qd, effort):
+        """Return (q, qd, effort) with the sensors' Gaussian noise."""
+        normal, n = self._rng.normal, q.size
+        sp, sv, se = self.noise
+        return (q + normal(0.0, sp, n), qd + normal(0.0, sv, n),
+                effort + normal(0.0, se, n))
 
     def _publish_contacts(self, plant, now):
         wrenches = plant.contact_wrenches()

@@ -33,7 +33,10 @@ mujoco_sim_node as a process: the MuJoCo plant over real DDS.
   ``~/contact_wrenches/bar`` (world axes, about the link's origin) holds
   it up against gravity at rest.
 - A bad robot_file or a wrong number of initial positions: one line, exit
-  status 2.
+  status 2; so is a negative or NaN sensor noise.
+- Sensor noise (``noise.*``): zero gives MuJoCo's state exactly; on, the
+  published states scatter about it with the requested standard
+  deviations (to sampling error), the plant itself untouched.
 """
 import math
 import os
@@ -419,6 +422,10 @@ def test_contact_wrench_of_a_bar_resting_on_the_floor(tmp_path):
      'robot_file: the scene gives it; leave it unset with scene'),
     ({'scene': 'puma_payload_press'},
      "scene: puma560.yaml: MuJoCo refuses link 'link1'"),
+    ({'robot_file': 'panda', 'noise': {'velocity': -0.1}},
+     'noise.velocity: must be >= 0'),
+    ({'robot_file': 'panda', 'noise': {'position': math.nan}},
+     'noise.position: must be finite, got nan'),
 ])
 def test_configuration_errors_are_one_line(tmp_path, params, message):
     proc = subprocess.run(node_cmd(tmp_path, **params),
@@ -473,3 +480,42 @@ def test_a_scene_makes_the_plant_and_its_pusher_is_felt_on_the_topic(
         assert pushes[-1].header.frame_id == 'base_link'
     finally:
         run.close()
+
+
+def held_states(tmp_path, offset, count, **params):
+    """Return ``count`` states (position, velocity, effort) while held."""
+    run = Session(tmp_path, offset, robot_file='panda',
+                  initial_positions=Q0, rate=500.0, **params)
+    try:
+        run.wait_up(count)
+        rows = [(m.position, m.velocity, m.effort)
+                for m in run.states[:count]]
+    finally:
+        run.close()
+    return [np.array([r[i] for r in rows]) for i in range(3)]
+
+
+def test_sensor_noise_off_is_mujoco_on_has_the_asked_deviation(tmp_path):
+    """
+    Brakes on, the true state is Q0 at rest with zero effort.
+
+    Noise zero: exactly that.  Noise on: the published values minus the
+    truth have the asked standard deviations, to sampling error (7 x 600
+    samples: about 1.1 % of sigma; the bound is 6 %), mean about zero.
+    """
+    q, qd, effort = held_states(tmp_path, 47, 50, noise={
+        'position': 0.0, 'velocity': 0.0, 'effort': 0.0, 'seed': 3})
+    np.testing.assert_array_equal(q, np.broadcast_to(Q0, q.shape))
+    np.testing.assert_array_equal(qd, 0.0)
+    np.testing.assert_array_equal(effort, 0.0)
+    sigma = {'position': 1e-3, 'velocity': 2e-2, 'effort': 0.05}
+    count = 600
+    q, qd, effort = held_states(tmp_path, 47, count,
+                                noise=dict(sigma, seed=3))
+    for name, err in (('position', q - np.asarray(Q0)),
+                      ('velocity', qd), ('effort', effort)):
+        s = sigma[name]
+        assert abs(err.std() - s) < 0.06 * s, (name, err.std(), s)
+        assert abs(err.mean()) < 5 * s / math.sqrt(err.size), name
+        # fresh noise every tick, every joint: no two samples alike
+        assert np.unique(err).size == err.size, name
