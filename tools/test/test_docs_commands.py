@@ -159,6 +159,7 @@ def run_page(page, cwd, passed=None):
             continue
         if text in passed:
             continue
+        started = time.monotonic()
         proc = subprocess.Popen(
             _command(lang, text, str(cwd)), cwd=str(cwd), env=env,
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
@@ -179,9 +180,21 @@ def run_page(page, cwd, passed=None):
             code = proc.returncode
         assert code == 0, (f'{where}: exit status {code} for\n{text}\n'
                            f'output:\n{out[-4000:]}')
+        _log_time(where, time.monotonic() - started)
         passed.add(text)
         ran += 1
     return ran
+
+
+def _log_time(where, seconds):
+    """Append one block's wall time to build/doc_block_seconds.txt."""
+    path = os.path.join(ROOT, 'build', 'doc_block_seconds.txt')
+    try:
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        with open(path, 'a', encoding='utf-8') as fh:
+            fh.write(f'{seconds:8.1f}  {where}\n')
+    except OSError:
+        pass                            # a record, not a check
 
 
 def test_pages_are_found():
