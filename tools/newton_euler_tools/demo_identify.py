@@ -440,6 +440,10 @@ class Loop:
         self.runs[TOLD] = last.finish(self.duration)
         self.steps.end()
 
+    def all_runs(self):
+        """Return every run, in the order they started."""
+        return (self.first, self.second, self.third, self.last)
+
     def run(self):
         """All six steps; DemoError if one fails (every run stopped)."""
         try:
@@ -449,7 +453,7 @@ class Loop:
             self.record_identified()
             self.estimate_payload()
             self.apply_estimate()
-            for r in (self.first, self.second, self.third, self.last):
+            for r in self.all_runs():
                 r.close()
         finally:
             for item in reversed(self.live):
@@ -477,6 +481,11 @@ def parse_args(argv):
     parser = loop_parser('demo_identify', __doc__,
                          'a short trajectory and optimisation (tests)')
     parser.add_argument('--seed', type=int, default=7)
+    parser.add_argument('--plant', choices=('mujoco', 'builtin'),
+                        default='mujoco',
+                        help='the robot: mujoco (mujoco_sim_node, a plant '
+                        'that is not the model; default) or builtin '
+                        "(robot_sim_node, the library's own dynamics)")
     return parser.parse_args(argv)
 
 
@@ -489,11 +498,15 @@ def main(argv=None):
     os.makedirs(out, exist_ok=True)
     keep_bytecode(out)
     try:
-        base = base_domain(4)
+        base = base_domain(5 if args.plant == 'mujoco' else 4)
     except ValueError as exc:
         print(f'demo_identify: {exc}', file=sys.stderr)
         return 2
-    loop = Loop(args, out, base, started)
+    if args.plant == 'mujoco':
+        from .demo_identify_mujoco import MujocoLoop
+        loop = MujocoLoop(args, out, base, started)
+    else:
+        loop = Loop(args, out, base, started)
     try:
         loop.run()
     except DemoError as exc:

@@ -27,28 +27,37 @@ def prepare_plots():
     import matplotlib.pyplot  # noqa: F401
 
 
+def _segment(segment, label):
+    """Return a run's plan: ``segment``, or its entry when it is a dict."""
+    return segment[label] if isinstance(segment, dict) else segment
+
+
 def plot(runs, segment, truth, out):
-    """Tracking error and feedforward torque error per run."""
+    """
+    Tracking error and feedforward torque error per run.
+
+    ``segment``: the plan of every run, or a dict of each run's plan.
+    """
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(9, 4))
     for label, r in runs.items():
-        err = np.linalg.norm(r['q'] - plan_at(r['t'], segment), axis=1)
+        plan = plan_at(r['t'], _segment(segment, label))
+        err = np.linalg.norm(r['q'] - plan, axis=1)
         ax.semilogy(r['t'], err + 1e-9, label=label, lw=0.9)
     ax.set_xlabel('simulated time (s)')
     ax.set_ylabel('|q - q_plan| (rad)')
-    ax.set_title('Panda: tracking error along the excitation trajectory')
+    ax.set_title('Panda: tracking error along the plan')
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(out, 'tracking.png'), dpi=100)
     plt.close(fig)
     fig, axes = plt.subplots(7, 1, sharex=True, figsize=(9, 12))
-    t = segment[0]
     for j, ax in enumerate(axes):
         for label, r in runs.items():
-            ax.plot(t, r['ff'][:, j] - truth[label][:, j], lw=0.8,
-                    label=label)
+            ax.plot(_segment(segment, label)[0],
+                    r['ff'][:, j] - truth[label][:, j], lw=0.8, label=label)
         ax.set_ylabel(f'joint {j + 1}\nN m', fontsize=8)
     axes[0].set_title('feedforward effort minus the true torque')
     axes[0].legend(fontsize=7, ncol=2)
@@ -73,7 +82,7 @@ def figures(runs, truth, segment):
         ff = r['ff'] - truth[label]
         ff_rms = float(np.sqrt(np.mean(ff ** 2)))
         ff_rel = ff_rms / float(np.sqrt(np.mean(truth[label] ** 2)))
-        err = r['q'] - plan_at(r['t'], segment)
+        err = r['q'] - plan_at(r['t'], _segment(segment, label))
         tr_rms = float(np.sqrt(np.mean(err ** 2)))
         tr_max = float(np.abs(err).max())
         out[label] = {'ff_rms': ff_rms, 'ff_rel': ff_rel,
@@ -149,21 +158,34 @@ def summary_lines(loop, payload, wall, rows):
 
 
 def write_report(loop, payload, started):
-    """Write the plots, summary.md and summary.json; print the table."""
+    """
+    Write the plots, summary.md and summary.json; print the table.
+
+    A loop with a ``held_out`` error (the MuJoCo plant's) writes its own
+    summary (``loop.summary_lines``) and adds its figures
+    (``loop.figures``) to summary.json.
+    """
     out = loop.out
-    plot(loop.runs, loop.segment, loop.truth, out)
-    table, rows = figures(loop.runs, loop.truth, loop.segment)
+    segment = getattr(loop, 'segments', None) or loop.segment
+    plot(loop.runs, segment, loop.truth, out)
+    table, rows = figures(loop.runs, loop.truth, segment)
     wall = time.monotonic() - started
-    lines = summary_lines(loop, payload, wall, rows)
+    mujoco = hasattr(loop, 'held_out')
+    if mujoco:
+        lines, headline = loop.summary_lines(payload, wall, rows, table)
+    else:
+        lines = summary_lines(loop, payload, wall, rows)
+        headline = []
     with open(os.path.join(out, 'summary.md'), 'w', encoding='utf-8') as f:
         f.write('\n'.join(lines))
+    result = {'plant': 'mujoco' if mujoco else 'builtin', 'runs': table,
+              'payload_estimate': loop.estimate, 'payload_true': payload,
+              'wall_s': wall, 'steps_s': loop.steps.times,
+              'runs_timing_s': {r.label: r.timing(started)
+                                for r in loop.all_runs()}}
+    if mujoco:
+        result.update(loop.figures(table))
     with open(os.path.join(out, 'summary.json'), 'w', encoding='utf-8') as f:
-        json.dump({'runs': table, 'payload_estimate': loop.estimate,
-                   'payload_true': payload, 'wall_s': wall,
-                   'steps_s': loop.steps.times,
-                   'runs_timing_s': {
-                       r.label: r.timing(started) for r in (
-                           loop.first, loop.second, loop.third, loop.last)}},
-                  f, indent=1)
-    print('\n'.join(lines[4:6 + len(rows)]))
+        json.dump(result, f, indent=1)
+    print('\n'.join(lines[4:6 + len(rows)] + headline))
     print(f'wrote {out} ({wall:.0f} s)', flush=True)

@@ -13,20 +13,24 @@
 # limitations under the License.
 
 """
-The runs of ``make demo-identify``: a node and a simulator over DDS.
+The runs of ``make demo-identify``: a node and a plant over DDS.
 
-``LoopRun`` starts one run's pair of processes (inverse_dynamics_node and
-robot_sim_node) in a ROS domain of its own, gives the node its model and
-the plan, records ``/joint_states`` (``LoopRecorder``, optionally into a
-rosbag2) and stops them; ``wait_until`` and ``drive`` step several runs
-at once.  ``demo_identify`` composes them into the loop.
+``LoopRun`` starts one run's processes in a ROS domain of its own,
+gives the node its model and the plan, records ``/joint_states``
+(``LoopRecorder``, optionally into a rosbag2) and stops them;
+``wait_until`` and ``drive`` step several runs at once.
+``demo_identify`` composes them into the loop.  The plant is MuJoCo
+(``mujoco``: mujoco_sim_node, efforts in, fed by
+:mod:`.trajectory_controller`, which takes the node's filled plan) or
+the library's own simulator (``builtin``: robot_sim_node, which takes
+the plan itself).
 """
 import os
 import shutil
 import threading
 import time
 
-from newton_euler_ros.graph import ID, SIM
+from newton_euler_ros.graph import EFFORT_COMMANDS, ID, SIM
 import numpy as np
 
 from .demo import (check_exits, Child, DemoError, poll, Recorder,
@@ -35,6 +39,15 @@ from .demo_pick import trajectory_message
 from .ident_example import BASE, TIP
 
 JOINTS = [f'panda_joint{k}' for k in range(1, 8)]
+CONTROLLER = '/trajectory_controller'
+# per plant: the topic the node's filled plan goes to, the topic of t = 0
+# of the plan, the plant's command topic
+TOPICS = {
+    'builtin': (f'{SIM}/joint_trajectory', f'{SIM}/start',
+                f'{SIM}/commands'),
+    'mujoco': (f'{CONTROLLER}/joint_trajectory', f'{CONTROLLER}/start',
+               EFFORT_COMMANDS),
+}
 
 
 class LoopRecorder(Recorder):
@@ -50,9 +63,10 @@ class LoopRecorder(Recorder):
     recorder), so a run's processes can start well before it goes.
     """
 
-    def __init__(self, domain, name):
+    def __init__(self, domain, name, plant='builtin'):
         self.opened = False
-        super().__init__(domain, name=name)
+        filled, start, commands = TOPICS[plant]
+        super().__init__(domain, name=name, start=start, commands=commands)
         from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
         from rclpy.qos import (DurabilityPolicy, QoSProfile,
                                ReliabilityPolicy)
@@ -65,7 +79,7 @@ class LoopRecorder(Recorder):
         self._diagnostic_ok = DiagnosticStatus.OK
         # (wall-clock arrival, message) of what the node passed on
         self.node.create_subscription(
-            JointTrajectory, f'{SIM}/joint_trajectory',
+            JointTrajectory, filled,
             lambda msg: self.filled.append((time.time(), msg)), 10)
         self.plan = self.node.create_publisher(JointTrajectory,
                                                f'{ID}/trajectory_in', 10)
@@ -161,21 +175,28 @@ def _array(values):
 
 class LoopRun:
     """
-    One run: robot_sim_node and inverse_dynamics_node, a ROS domain each.
+    One run: a plant and inverse_dynamics_node, a ROS domain each.
 
-    Both processes start at once, on construction; the node gets the
+    The processes start at once, on construction; the node gets the
     URDF as ``robot_file`` or, when ``urdf`` is None, later on
     ``robot_description`` (:meth:`describe`).  :meth:`go` lets the
-    simulator start; the plan is sent, stamped at its t = 0, as soon as
-    it announces it (half a second ahead; the simulator then holds t = 0
-    for up to a second until the plan comes).  :meth:`finish` returns the
-    recorded arrays and stops the processes in a thread; :meth:`close`
-    waits for them.
+    simulator start.  On the builtin plant the plan is sent, stamped at
+    its t = 0, as soon as the simulator announces it (half a second
+    ahead; the simulator then holds t = 0 for up to a second until the
+    plan comes).  On MuJoCo (``plant='mujoco'``: mujoco_sim_node with
+    ``noise``, its ``noise.*``, and trajectory_controller with the
+    ``gains`` (kp, kd)) the plan is sent stamped 0 once the plant ticks:
+    the controller starts it at the next joint state and says when on
+    its ``~/start``, t = 0 of the run; the brakes hold the arm until
+    then.  :meth:`finish` returns the recorded arrays and stops the
+    processes in a thread; :meth:`close` waits for them.
     """
 
     def __init__(self, label, scene, domain, log_dir, urdf=None,
-                 compensate=False, plant_payload=None):
+                 compensate=False, plant_payload=None, plant='builtin',
+                 noise=None, gains=None):
         self.label = label
+        self.plant = plant
         self.children = []
         self.status = {}
         self.segment = None
@@ -183,7 +204,12 @@ class LoopRun:
         self._stopper = None
         self.closed = False
         self.times = {'start': time.monotonic()}    # wall clock, per phase
-        self.rec = LoopRecorder(domain, f'demo_recorder_{label}')
+        self.rec = LoopRecorder(domain, f'demo_recorder_{label}', plant)
+        self.filled_topic = TOPICS[plant][0]
+        if plant == 'mujoco':
+            self._mujoco_children(label, scene, domain, log_dir, urdf,
+                                  compensate, noise or {}, gains)
+            return
         sim_args = ['-p', f'scene:={scene}', '-p', 'wait_for_subscribers:=2']
         if plant_payload:
             sim_args += [
@@ -205,6 +231,43 @@ class LoopRun:
             'newton_euler_ros.nodes.inverse_dynamics_node', id_args, domain,
             log_dir))
 
+    def _mujoco_children(self, label, scene, domain, log_dir, urdf,
+                         compensate, noise, gains):
+        """
+        mujoco_sim_node, inverse_dynamics_node, trajectory_controller.
+
+        The plant (its payload, if any, in the scene) starts its clock
+        once the controller and the recorder subscribe to joint_states;
+        the node only fills the plan (its joint_states are remapped
+        away: nothing else of it is used here).
+        """
+        sim_args = ['-p', f'scene:={scene}', '-p', 'wait_for_subscribers:=2',
+                    '-p', 'lockstep:=true', '-p', 'real_time_factor:=0.0']
+        for key, value in noise.items():
+            sim_args += ['-p', f'noise.{key}:={value!r}']
+        id_args = ['-p', f'base_link:={BASE}', '-p', f'tip_link:={TIP}',
+                   '-p', 'mode:=gravity', '-p', 'drives.compensate:='
+                   f'{"true" if compensate else "false"}',
+                   '-p', 'diagnostics_period:=0.2',
+                   '-r', f'~/trajectory_out:={self.filled_topic}',
+                   '-r', f'joint_states:={CONTROLLER}/unused_joint_states']
+        if urdf:
+            id_args = ['-p', f'robot_file:={urdf}', *id_args]
+        kp, kd = gains
+        controller_args = ['-p', f'joints:={JOINTS!r}'.replace("'", '"'),
+                           '-p', f'kp:={_array(kp)}', '-p', f'kd:={_array(kd)}']
+        self.children.append(Child(f'{label}_mujoco_sim_node',
+                                   'newton_euler_ros.nodes.mujoco_sim_node',
+                                   sim_args, domain, log_dir))
+        self.children.append(Child(
+            f'{label}_inverse_dynamics_node',
+            'newton_euler_ros.nodes.inverse_dynamics_node', id_args, domain,
+            log_dir))
+        self.children.append(Child(
+            f'{label}_trajectory_controller',
+            'newton_euler_tools.trajectory_controller', controller_args,
+            domain, log_dir))
+
     def describe(self, text):
         """Give the node its URDF on robot_description."""
         self.rec.describe(text)
@@ -219,10 +282,15 @@ class LoopRun:
         """Both nodes up and matched, the node's model loaded."""
         self.check()
         rec = self.rec
-        return (rec.publishers('/joint_states') >= 1
-                and rec.plan.get_subscription_count() >= 1
-                and rec.publishers(f'{SIM}/joint_trajectory') >= 1
-                and rec.model_loaded)
+        ready = (rec.publishers('/joint_states') >= 1
+                 and rec.plan.get_subscription_count() >= 1
+                 and rec.publishers(self.filled_topic) >= 1
+                 and rec.model_loaded)
+        if self.plant == 'mujoco':     # the controller hears and is heard
+            ready = ready and (rec.subscribers(self.filled_topic) >= 2
+                               and rec.publishers(EFFORT_COMMANDS) >= 1
+                               and rec.subscribers(EFFORT_COMMANDS) >= 2)
+        return ready
 
     def go(self, segment):
         """Let the simulator start; the plan follows its start time."""
@@ -234,6 +302,14 @@ class LoopRun:
         """Send the plan once t = 0 is known; True once it is sent."""
         self.check()
         rec = self.rec
+        if self.plant == 'mujoco':
+            # stamped 0: the controller starts it at the next state
+            if not self.sent and rec.states:
+                rec.plan.publish(trajectory_message(JOINTS, 0.0,
+                                                    self.segment))
+                self.sent = True
+                self.times['plan sent'] = time.monotonic()
+            return self.sent and rec.t0 is not None
         if not self.sent and rec.t0 is not None:
             rec.plan.publish(trajectory_message(JOINTS, rec.t0,
                                                 self.segment))
@@ -259,8 +335,9 @@ class LoopRun:
             raise DemoError(f'[{self.label}] the simulator did not get the '
                             f'trajectory with efforts')
         arrival, plan = rec.filled[0]
-        # > 0: the simulator held t = 0 that long for the plan
-        self.times['plan late'] = arrival - rec.t0
+        if self.plant == 'builtin':
+            # > 0: the simulator held t = 0 that long for the plan
+            self.times['plan late'] = arrival - rec.t0
         states = list(rec.states)
         ns = np.array(rec.stamps_ns, dtype=np.int64)
         t = np.array([s[0] for s in states]) - rec.t0

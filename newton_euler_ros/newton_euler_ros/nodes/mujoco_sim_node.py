@@ -63,6 +63,14 @@ from a generator seeded with ``noise.seed``, as a driver's encoders,
 velocity estimate and torque readings have it; the plant itself is
 not touched.  All zero (the default): MuJoCo's state exactly.
 
+With ``lockstep``, once the brakes are released a tick advances only
+when a valid command came after the last joint state (a controller
+answering each state at the driver's rate, its deadline always met);
+after ``command_timeout`` seconds of wall clock without one the ticks go
+on without waiting until the next command.  With ``real_time_factor``
+0 as well, each command ticks at once: the loop runs as fast as the
+plant and its controller can answer each other.
+
 Subscribes
     effort_controller/commands (std_msgs/Float64MultiArray: one effort
     per joint of ``joints``, N m or N; what ros2_control's effort forward
@@ -198,6 +206,9 @@ class MujocoSimNode(SharedGraphNode):
         sigma = [p[f'noise.{k}'] for k in ('position', 'velocity', 'effort')]
         self.noise = sigma if any(sigma) else None
         self._rng = np.random.default_rng(p['noise.seed'])
+        self.lockstep = p['lockstep']
+        self.fresh = False      # a valid command since the last state
+        self._waiting = None    # wall time a lockstep wait began
 
         qos = qos_profile(100, 'reliable')
         self.state_pub = self.create_publisher(JointState, 'joint_states',
@@ -286,6 +297,11 @@ class MujocoSimNode(SharedGraphNode):
         self.plant = plant
         self._window = (time.monotonic(), plant.time)
         wall_period = 0.0 if self.rtf == 0.0 else self.period / self.rtf
+        # lockstep as fast as it can: the commands drive the ticks, the
+        # timer only the brakes' time and the end of a wait
+        self._driven = self.lockstep and self.rtf == 0.0
+        if self._driven:
+            wall_period = self.period
         self.create_tick_timer(wall_period, self._tick, clock=self.wall)
 
     def _contact_topics(self, plant):
@@ -349,6 +365,12 @@ class MujocoSimNode(SharedGraphNode):
             return
         self.received += 1
         self.tau = data
+        self.fresh = True
+        if self._waiting is False:
+            self.get_logger().info('lockstep resumed')
+        self._waiting = None
+        if self._driven and self.started and not self.plant.held:
+            self._tick()
         self.last_command = self.plant.time
         if self.stale:
             self.stale = False
@@ -374,6 +396,9 @@ class MujocoSimNode(SharedGraphNode):
             plant.release()
             self.get_logger().info(
                 f'first command at t = {plant.time:.3f} s: brakes released')
+        if self.lockstep and not plant.held and not self._lockstep_ready():
+            return
+        self.fresh = False
         tau = self.tau
         if not plant.held and not self.stale and \
                 plant.time - self.last_command >= self.timeout - 1e-9:
@@ -387,6 +412,22 @@ class MujocoSimNode(SharedGraphNode):
             tau = self._zero
         plant.advance(tau, self.period)
         self._publish(plant)
+
+    def _lockstep_ready(self):
+        """Return True when this tick may advance (fresh command, no wait)."""
+        if self.fresh or self._waiting is False:
+            return True
+        now = time.monotonic()
+        if self._waiting is None:
+            self._waiting = now
+        elif now - self._waiting >= self.timeout:
+            self._waiting = False
+            self.get_logger().warning(
+                f'lockstep: no command for {self.timeout:g} s of wall '
+                f'clock (t = {self.plant.time:.3f} s): ticking without '
+                'waiting until the next one')
+            return True
+        return False
 
     def _publish(self, plant):
         now = stamp(plant.time)
