@@ -49,6 +49,7 @@ os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')
 
 import numpy as np  # noqa: E402 (after the BLAS thread count)
 
+from .cli_export import register as register_export  # noqa: E402
 from .cli_identify import register as register_identify  # noqa: E402
 from .cli_loop import register as register_loop  # noqa: E402
 from .cli_observe import register as register_observe  # noqa: E402
@@ -478,6 +479,7 @@ def build_parser():
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)
     register_identify(sub)
+    register_export(sub)
     register_observe(sub)
     register_loop(sub)
     register_ros(sub)
