@@ -89,6 +89,8 @@ from .observer_contact import (contact_step, ContactState,  # noqa: F401
 from .observer_thresholds import (beyond_friction,  # noqa: F401
                                   suggest_thresholds)
 from .observer_wrench import external_wrench, felt_directions  # noqa: F401
+from .observer_wrenches import (external_wrenches,  # noqa: F401
+                                own_joints, separability, Wrenches)
 from .workspace import Workspace
 
 # this file's compiled functions call kernels: a kernel edit must
