@@ -189,6 +189,16 @@ class NodeObserver:
             msg = WrenchStamped()
             msg.header.frame_id = link
             out.append((link, msg, np.zeros(6)))
+        #: two links or more: estimated jointly (core/observer_wrenches.py)
+        self._joint = None
+        own = momentum.own_joints(model, links) if len(links) > 1 else ()
+        for link, joints in zip(links, own):
+            if not joints and ('alone', link) not in self.said:
+                self.said.add(('alone', link))
+                self.node.get_logger().warning(
+                    f'observer: {link!r} has no joint of its own (every '
+                    f'joint that moves it moves another of '
+                    f'observer.end_effectors too): its wrench stays zero')
         return out
 
     def _says(self, key, status, text):
@@ -253,7 +263,14 @@ class NodeObserver:
             # the model's torque: what the drives apply plus the residual
             if units.add(stamp, torque + r, torque, ff.last_qd):
                 self._units_checked(units)
-        if self._links:
+        before = self.contact.in_contact
+        now = momentum.contact_step(obs, self.contact, r,
+                                    self.state.allowance, stamp, ff.last_q,
+                                    ff.last_qd)
+        if len(self._links) > 1:
+            self._joint_wrenches(obs, ff.last_q, r)
+            F = None
+        elif self._links:
             for link, _, F in self._links:
                 momentum.external_wrench(obs, ff.last_q, r, out=F,
                                          frame=link, axes='link')
@@ -263,12 +280,29 @@ class NodeObserver:
         else:
             F = momentum.external_wrench(obs, ff.last_q, r,
                                          out=self._wrench_out)
-        before = self.contact.in_contact
-        now = momentum.contact_step(obs, self.contact, r,
-                                    self.state.allowance, stamp, ff.last_q,
-                                    ff.last_qd)
         self.status = 'running'
         return r, F, before, now
+
+    def _joint_wrenches(self, obs, q, r):
+        """
+        Estimate the links' wrenches jointly into their buffers.
+
+        A link whose own joints feel no contact (the contact test just
+        run) reads zero; which components the joints cannot separate is
+        said once, at the first pose, and kept for /diagnostics.
+        """
+        links = [link for link, _, _ in self._links]
+        if 'separable' not in self.said:
+            self.said.add('separable')
+            self.node.get_logger().info(
+                f'observer: wrenches of {", ".join(links)} estimated '
+                f'jointly; not separable by the joints (at the first pose, '
+                f'all pushed): '
+                + momentum.separability(obs, q, links, axes='link').text())
+        self._joint = momentum.external_wrenches(
+            obs, q, r, links, axes='link', contact=self.contact)
+        for (_, _, F), values in zip(self._links, self._joint.wrench):
+            F[:] = values
 
     def _units_checked(self, units):
         """Say a window's verdict on the efforts' unit when it changes."""
@@ -367,6 +401,10 @@ class NodeObserver:
             KeyValue(key='rest_reference', value=_rest_text(
                 self.params['observer.rest_reference'], contact)),
             KeyValue(key='effort_units', value=_units_text(units))]
+        joint = getattr(self, '_joint', None)
+        if joint is not None:       # the joint estimate's last say
+            status.values.append(KeyValue(
+                key='wrench_not_separable', value=joint.text()))
         return status
 
 
