@@ -92,6 +92,8 @@ CASES = {
                  ['{urdf}', '{missing}', *CHAIN, '-o', '{out}.urdf']),
     'replay': (['{urdf}', '{bag}', *CHAIN, '--csv', '{out}.csv'],
                ['{urdf}', '{missing}', *CHAIN, '--csv', '{out}.csv']),
+    'export': (['{urdf}', '--format', 'franka', '-o', '{out}.yaml'],
+               ['{missing}', '--format', 'franka', '-o', '{out}.yaml']),
     'payload': (['{urdf}', '{bag}', *CHAIN],
                 ['{urdf}', '{missing}', *CHAIN]),
     'observe': (['{urdf}', '{bag}', *CHAIN, '--csv', '{out}.csv'],
