@@ -4,8 +4,8 @@
 #                and tools/test (pytest.ini)
 #   make demo    closed-loop ROS 2 demo of the default scene; report in out/demo/
 #   make demo-pick  trajectory efforts + a payload picked up; out/demo_pick/
-#   make demo-identify  excite, record, identify, payload (about a minute);
-#                out/demo_identify/
+#   make demo-identify  excite, record, identify, payload, over DDS on a
+#                Panda simulated by MuJoCo (a few minutes); out/demo_identify/
 #   make demo-identify-mujoco  the same loop offline on a Panda simulated by
 #                MuJoCo (about a minute); out/mujoco_identify/
 #   make bench   run the benchmarks (peers side by side; cost per effect;
