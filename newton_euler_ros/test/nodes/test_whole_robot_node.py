@@ -42,8 +42,8 @@ only, no ``tip_link``, the left arm's joints (shuffled) on
   same inertia added to the gripper's joint;
 - the momentum observer on efforts of a robot at rest pushed at its left
   gripper: the external torque on every joint is J^T F, and of the
-  wrenches of ``observer.end_effectors`` the left gripper's is F, the
-  right one's zero.
+  wrenches of ``observer.end_effectors`` (estimated jointly) the left
+  gripper's is F, the right one's zero, and nothing is ambiguous.
 
 And PR2 from ``robot_file``: the start-up line counts its ten mimic
 joints, the next line lists them all under their leaders, none cut off.
@@ -120,6 +120,8 @@ class Robot:
             '-p', 'wrench.convention:=applied_to_robot',
             '-p', 'observer.enabled:=true', '-p', 'observer.damping:=0.0',
             '-p', f'observer.end_effectors:=[{", ".join(WRISTS)}]',
+            # a link's wrench needs a contact on its own joints
+            '-p', 'observer.thresholds:=[1.0]',
             '-p', 'log_throttle:=0.01'),
             self.domain, os.path.join(tmp, 'node.log'))
         self.torques = self.probe.collect(JointState, f'{NODE}/torques')
@@ -452,6 +454,20 @@ def test_the_observer_reports_each_end_effector(robot, baxter):
         values = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y,
                   w.torque.z]
         np.testing.assert_allclose(values, expected, rtol=0, atol=1e-6)
+    # estimated jointly; the two arms share no joint: all separable
+    assert 'left_gripper, right_gripper estimated jointly; not separable ' \
+        'by the joints (at the first pose, all pushed): none' in \
+        robot.node.log(), robot.node.log()
+
+    def separable():
+        for msg in robot.diag:
+            for status in msg.status:
+                if status.name.endswith(': observer'):
+                    values = {v.key: v.value for v in status.values}
+                    if 'wrench_not_separable' in values:
+                        return values['wrench_not_separable']
+    assert robot.probe.spin_until(lambda: separable() is not None, 5.0)
+    assert separable() == 'none'
 
 
 def test_the_simulated_tree_held_by_the_node(baxter, tmp_path):
@@ -647,3 +663,64 @@ def test_one_arm_without_the_wheels_and_a_locked_gripper(tmp_path):
         commands[-1].data, expected[[names.index(j) for j in arm]],
         rtol=1e-12, atol=1e-12)
     assert 'missing' not in node.log(), node.log()
+
+
+def test_a_push_on_one_pr2_hand_is_not_read_at_the_other(tmp_path):
+    """
+    PR2 resting, pushed at its right hand (issue 37): the torso is shared.
+
+    Estimating each hand alone read the torso's share at the left hand
+    (37.5 N for a 15 N push); jointly, the right hand's wrench is F and
+    the left one's zero, the seven-joint arms leaving nothing ambiguous.
+    """
+    import time
+    from newton_euler_tools.peers import example_robot_urdf, PinocchioTree
+    path = example_robot_urdf('pr2_description/urdf/pr2.urdf')
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        model = load_urdf(path)
+    hands = ('r_gripper_tool_frame', 'l_gripper_tool_frame')
+    q = 0.3 * np.sin(np.arange(model.n) + 1.0)
+    for k, name in enumerate(model.joint_names):
+        if 'torso' in name or 'gripper' in name:
+            q[k] = 0.02
+    rest = np.zeros(model.n)
+    F = np.array([5.0, -3.0, -15.0, 0.4, 0.6, -0.2])
+    theirs = PinocchioTree(path, model).terms(q, rest, rest, hands)
+    effort = dict(zip(model.joint_names, theirs['g'] - theirs[
+        f'J {hands[0]} link'].T @ F))
+    x, v = moving_state(model, q, rest)
+    names = list(model.moving_joints)
+    domain = domain_id(13)
+    probe = Probe(domain)
+    node = NodeProcess(id_node_cmd(
+        None, '-p', f'robot_file:={path}', '-p', 'observer.enabled:=true',
+        '-p', 'observer.damping:=0.0', '-p', 'observer.thresholds:=[1.0]',
+        '-p', f'observer.end_effectors:=[{", ".join(hands)}]'),
+        domain, str(tmp_path / 'node.log'))
+    try:
+        wrenches = probe.collect(WrenchStamped, f'{NODE}/external_wrench')
+        states = probe.publisher(JointState, '/joint_states')
+        deadline = time.monotonic() + 90.0
+        k = 0
+        while len(wrenches) < 2 * 40:   # 40 samples: 2 time constants x 10
+            assert node.alive() and time.monotonic() < deadline, node.log()
+            k += 1
+            msg = joint_state(names, [x[j] for j in names],
+                              [v[j] for j in names], probe.keyed_stamp(k))
+            msg.effort = [effort.get(j, 0.0) for j in names]
+            states.publish(msg)
+            probe.spin_for(0.01)
+    finally:
+        assert node.stop() == 0, node.log()
+        probe.close()
+    last = {m.header.frame_id: m.wrench for m in wrenches[-2:]}
+    assert set(last) == set(hands)
+    for link, expected in zip(hands, (F, 0 * F)):
+        w = last[link]
+        values = [w.force.x, w.force.y, w.force.z, w.torque.x, w.torque.y,
+                  w.torque.z]
+        np.testing.assert_allclose(values, expected, rtol=0, atol=1e-3)
+    assert not any(m.wrench.force.z for m in wrenches
+                   if m.header.frame_id == hands[1])
+    assert 'all pushed): none' in node.log(), node.log()
