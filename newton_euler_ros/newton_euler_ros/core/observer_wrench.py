@@ -159,7 +159,8 @@ def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
     the moment about its origin, in base axes or the frame's own
     (``axes='link'``), from J of that frame.  Only the joints between it
     and the base take part; on a tree a push elsewhere that shows on
-    those joints (a torso's) is read as this frame's.
+    those joints (a torso's) is read as this frame's: estimate several
+    frames jointly with :func:`.observer_wrenches.external_wrenches`.
     """
     if frame is not None:
         return _wrench_at_frame(obs, q, r, out, frame, axes)
