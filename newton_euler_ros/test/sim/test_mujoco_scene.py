@@ -35,10 +35,10 @@ from newton_euler_ros.core.observer import (external_wrench,
                                             observe_recording)
 from newton_euler_ros.core.robot_file import read_yaml
 from newton_euler_ros.sim.mujoco_scene import scene_plant
+from newton_euler_ros.sim.run import simulate
 from newton_euler_ros.sim.scene import load_scene, scene_dirs, \
     scene_from_dict
-from newton_euler_ros.sim.simulate import (SceneDynamics, simulate,
-                                           tracking_controller)
+from newton_euler_ros.sim.simulate import SceneDynamics, tracking_controller
 import numpy as np
 import pytest
 

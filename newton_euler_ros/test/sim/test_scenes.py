@@ -20,9 +20,10 @@ from newton_euler_ros.core import (gravity_torques, inverse_dynamics,
                                    load_robot, RobotFileError)
 from newton_euler_ros.core.model import with_payload
 from newton_euler_ros.core.robot_file import read_yaml
+from newton_euler_ros.sim.run import simulate
 from newton_euler_ros.sim.scene import load_scene, scene_dirs, \
     scene_from_dict
-from newton_euler_ros.sim.simulate import SceneDynamics, simulate
+from newton_euler_ros.sim.simulate import SceneDynamics
 import numpy as np
 import pytest
 
@@ -292,7 +293,6 @@ def test_scene_controller_is_stable_sampled_at_its_rate(name):
     import dataclasses
 
     from newton_euler_tools.accuracy.scenes import held_controller
-    from newton_euler_ros.sim.run import simulate
     scene = load_scene(name)
     for gain in (1.0, 1.5):
         sc = dataclasses.replace(scene, kp=gain * scene.kp,
