@@ -15,7 +15,9 @@
 """
 Every public float64 call of the core once, on the robot files given.
 
-    NUMBA_BOUNDSCHECK=1 python bounds_calls.py URDF [URDF ...]
+    NUMBA_BOUNDSCHECK=1 python bounds_calls.py URDF[:BASE:TIP] ...
+
+(a whole tree, or the chain from BASE to TIP, which has a tool frame)
 
 Run by ``core/test_bounds_checked.py`` with numba's bounds checks on: an
 offset off by one or an argument shorter than the recursion reads raises
@@ -67,10 +69,11 @@ def calls(core, m, rng):
 def main(paths):
     from newton_euler_ros import core
     failed = 0
-    for path in paths:
+    for given in paths:
+        path, *chain = given.split(':')
         with warnings.catch_warnings():
             warnings.simplefilter('ignore')
-            m = core.load_urdf(path)
+            m = core.load_urdf(path, *chain)
         for name, thunk in calls(core, m, np.random.default_rng(0)):
             try:
                 thunk()

@@ -40,6 +40,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 SCRIPT = os.path.join(os.path.dirname(HERE), 'bounds_calls.py')
 ROBOTS = ('centauro_description/urdf/centauro.urdf',
           'ur_description/urdf/ur5_robot.urdf')
+CHAINS = ('', ':base_link:tool0')    # the UR5 as a chain: a tool frame
 
 
 def _cache_dir():
@@ -52,7 +53,7 @@ def _cache_dir():
 @pytest.mark.slow
 def test_every_call_reads_within_its_arguments():
     from newton_euler_tools.peers import example_robot_urdf
-    paths = [example_robot_urdf(r) for r in ROBOTS]
+    paths = [example_robot_urdf(r) + c for r, c in zip(ROBOTS, CHAINS)]
     env = dict(os.environ, NUMBA_BOUNDSCHECK='1',
                NUMBA_CACHE_DIR=_cache_dir())
     res = subprocess.run([sys.executable, SCRIPT, *paths], env=env,
