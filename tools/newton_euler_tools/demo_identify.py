@@ -291,7 +291,45 @@ UNTOLD = f'{PAYLOAD["mass"]:g} kg payload, node not told'
 TOLD = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
 
 
-class Loop:
+class PayloadSteps:
+    """
+    Steps 5 and 6 of the loop, the same on either plant.
+
+    A loop has ``steps``, ``identified``, ``bag2`` (the payload
+    recording), ``last`` (the run the estimate is applied to), ``segment``
+    and ``path``; ``last_seconds()`` and ``keep_told(run)`` are the
+    plant's own.
+    """
+
+    def estimate_payload(self):
+        """5: ``payload --json`` on the payload recording."""
+        self.steps.begin('payload', '[5/6] newton-euler payload --json')
+        found = json.loads(newton_euler(
+            'payload', self.identified, self.bag2, '--base', BASE, '--tip',
+            TIP, '--json', log=self.path('payload.json')))
+        # what the motion does not determine is null: the node keeps its
+        # value of those parameters
+        self.estimate = {k: v for k, v in found.items()
+                         if k.startswith('payload.') and v is not None
+                         and not (isinstance(v, list) and None in v)}
+        self.steps.end()
+
+    def apply_estimate(self):
+        """6: the estimate set on the node in one call, the plan again."""
+        last = self.last
+        self.steps.begin('estimate applied', '[6/6] the estimate set on the '
+                         'node (set_parameters_atomically), run again')
+        wait_until([last], last.ready, 'the nodes of the last run')
+        last.rec.set_payload(self.estimate)
+        last.go(self.segment)
+        wait_until([last], last.begun, 'the simulation start')
+        prepare_plots()         # while the last run runs
+        drive([last], self.last_seconds())
+        self.keep_told(last)
+        self.steps.end()
+
+
+class Loop(PayloadSteps):
     """
     The demo's six steps, one method each, in the order they run.
 
@@ -413,32 +451,13 @@ class Loop:
         self.runs[UNTOLD] = third.finish(self.duration, bag=self.bag2)
         self.steps.end()
 
-    def estimate_payload(self):
-        """5: ``payload --json`` on the second recording."""
-        self.steps.begin('payload', '[5/6] newton-euler payload --json')
-        found = json.loads(newton_euler(
-            'payload', self.identified, self.bag2, '--base', BASE, '--tip',
-            TIP, '--json', log=self.path('payload.json')))
-        # what the motion does not determine is null: the node keeps its
-        # value of those parameters
-        self.estimate = {k: v for k, v in found.items()
-                         if k.startswith('payload.') and v is not None
-                         and not (isinstance(v, list) and None in v)}
-        self.steps.end()
+    def last_seconds(self):
+        """Return how long the last run drives (simulated s)."""
+        return self.duration
 
-    def apply_estimate(self):
-        """6: the estimate set on the node in one call, the plan again."""
-        last = self.last
-        self.steps.begin('estimate applied', '[6/6] the estimate set on the '
-                         'node (set_parameters_atomically), run again')
-        wait_until([last], last.ready, 'the nodes of the last run')
-        last.rec.set_payload(self.estimate)
-        last.go(self.segment)
-        wait_until([last], last.begun, 'the simulation start')
-        prepare_plots()         # while the last run runs
-        drive([last], self.duration)
+    def keep_told(self, last):
+        """Keep the last run's figures (the estimate applied)."""
         self.runs[TOLD] = last.finish(self.duration)
-        self.steps.end()
 
     def all_runs(self):
         """Return every run, in the order they started."""

@@ -41,15 +41,15 @@ state, into ``/effort_controller/commands``).
 6. The estimate set on the node (``set_parameters_atomically``), run
    again.
 """
-import json
 import os
 import shutil
 
 from .demo_identify import (ARMATURE, COULOMB, IDENTIFIED, KD, KP,
-                            load_segment, newton_euler, PAYLOAD, PUBLISHED,
-                            quiet_load, START, Steps, TOLD, true_torques,
-                            UNTOLD, VISCOUS, warm_excite)
-from .demo_identify_report import prepare_plots
+                            load_segment, newton_euler, PAYLOAD,
+                            PayloadSteps, PUBLISHED, quiet_load, START,
+                            Steps, TOLD, true_torques, UNTOLD, VISCOUS,
+                            warm_excite)
+from .demo_identify_report import payload_line
 from .demo_identify_runs import drive, LoopRun, wait_until
 from .ident_example import BASE, panda_path, TIP
 from .mujoco_identify import held_out_error
@@ -103,7 +103,7 @@ def write_mujoco_scene(path, robot_file, payload=None):
         f.write(text)
 
 
-class MujocoLoop:
+class MujocoLoop(PayloadSteps):
     """
     The six steps on MuJoCo, one method each, in the order they run.
 
@@ -257,30 +257,13 @@ class MujocoLoop:
         self._keep(UNTOLD, untold, self.segment, 'payload', bag=self.bag2)
         self.steps.end()
 
-    def estimate_payload(self):
-        """5: ``payload --json`` on the payload recording."""
-        self.steps.begin('payload', '[5/6] newton-euler payload --json')
-        found = json.loads(newton_euler(
-            'payload', self.identified, self.bag2, '--base', BASE, '--tip',
-            TIP, '--json', log=self.path('payload.json')))
-        self.estimate = {k: v for k, v in found.items()
-                         if k.startswith('payload.') and v is not None
-                         and not (isinstance(v, list) and None in v)}
-        self.steps.end()
+    def last_seconds(self):
+        """Return how long the last run drives (simulated s)."""
+        return self.duration(self.segment)
 
-    def apply_estimate(self):
-        """6: the estimate set on the node in one call, the plan again."""
-        last = self.last
-        self.steps.begin('estimate applied', '[6/6] the estimate set on the '
-                         'node (set_parameters_atomically), run again')
-        wait_until([last], last.ready, 'the nodes of the last run')
-        last.rec.set_payload(self.estimate)
-        last.go(self.segment)
-        wait_until([last], last.begun, 'the simulation start')
-        prepare_plots()         # while the last run runs
-        drive([last], self.duration(self.segment))
+    def keep_told(self, last):
+        """Keep the last run's figures (the estimate applied)."""
         self._keep(TOLD, last, self.segment, 'payload')
-        self.steps.end()
 
     def figures(self, table):
         """Return the held-out torque error and the two ratios."""
@@ -312,8 +295,6 @@ class MujocoLoop:
             f'{1000 * pub:.2f} mrad, identified + drive compensation '
             f'{1000 * ident:.2f} mrad: {f["tracking_ratio"]:.1f} times '
             'better']
-        m, c = self.estimate.get('payload.mass'), self.estimate.get(
-            'payload.com')
         n = self.noise
         lines = [
             '# The identification loop on MuJoCo, end to end over DDS', '',
@@ -331,12 +312,7 @@ class MujocoLoop:
             'true torque | tracking error, RMS (mrad) | max (mrad) |',
             '|---|---|---|---|---|', *rows, '',
             *[f'- {x}' for x in headline],
-            '- payload estimate: '
-            + (f'{m:.3f} kg' if m is not None else 'mass undetermined')
-            + f' (true {payload["mass"]:g}), com '
-            + (f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm'
-               if c is not None else 'undetermined') + ' (true '
-            f'[{", ".join(f"{1000 * v:.1f}" for v in payload["com"])}])',
+            payload_line(self.estimate, payload),
             '- wall time per step (s): ' + ', '.join(
                 f'{k} {v:.1f}' for k, v in self.steps.times.items()), '',
             'Files: `excitation.json`, `heldout.json`, `recording/`, '

@@ -92,6 +92,17 @@ def figures(runs, truth, segment):
     return out, rows
 
 
+def payload_line(estimate, payload):
+    """Return the summary's line: the payload estimate against the truth."""
+    m, c = estimate.get('payload.mass'), estimate.get('payload.com')
+    return ('- payload estimate: '
+            + (f'{m:.3f} kg' if m is not None else 'mass undetermined')
+            + f' (true {payload["mass"]:g}), com '
+            + (f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm'
+               if c is not None else 'undetermined') + ' (true '
+            f'[{", ".join(f"{1000 * v:.1f}" for v in payload["com"])}])')
+
+
 def summary_lines(loop, payload, wall, rows):
     """Return the lines of summary.md."""
     args, out, estimate = loop.args, loop.out, loop.estimate
@@ -103,7 +114,6 @@ def summary_lines(loop, payload, wall, rows):
     with open(os.path.join(out, 'identify.txt'), encoding='utf-8') as f:
         ident_lines = [x for x in f.read().splitlines()
                        if x.startswith(('rank', 'identified in'))]
-    m, c = estimate.get('payload.mass'), estimate.get('payload.com')
     lines = [
         '# The identification loop, end to end',
         '',
@@ -136,12 +146,7 @@ def summary_lines(loop, payload, wall, rows):
         '',
         f'- excite: {excite_lines[0].strip() if excite_lines else ""}',
         *[f'- identify: {x}' for x in ident_lines],
-        '- payload estimate: '
-        + (f'{m:.3f} kg' if m is not None else 'mass undetermined')
-        + f' (true {payload["mass"]:g}), com '
-        + (f'[{", ".join(f"{1000 * v:.1f}" for v in c)}] mm'
-           if c is not None else 'undetermined') + ' (true '
-        f'[{", ".join(f"{1000 * v:.1f}" for v in payload["com"])}])',
+        payload_line(estimate, payload),
         '- wall time per step (s; the nodes of a run start while an earlier '
         'step works): ' + ', '.join(f'{k} {v:.1f}'
                                     for k, v in steps.times.items()),
