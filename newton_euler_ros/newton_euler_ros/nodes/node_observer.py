@@ -412,17 +412,23 @@ def contact_text(obs, contact, r, allowance):
     """
     Name the joints in contact, each with its residual and threshold.
 
-    ``joint2 4.1 N m (threshold 2)``; ``+ 0.5 static friction`` where
+    ``joint2 4.1 N m (threshold 2)``, the threshold in effect at that
+    sample (grown with the joint's speed and acceleration when the
+    observer has speed or acceleration thresholds); ``+ 0.5 static
+    friction`` where
     the joint's static friction allowance raises the bound; a joint
     found by the rest reference alone by its change from its rest value.
     """
     units = joint_units(obs.model)
+    # the threshold in effect: grown with speed and acceleration if set
+    thresholds = (contact.threshold if obs.moving_thresholds and
+                  contact.threshold is not None else obs.thresholds)
     rest = contact.rest
     by_rest = (rest.active if rest is not None and obs.rest_reference
                else np.zeros(obs.n, dtype=bool))
     parts = []
     for j, name in enumerate(obs.model.joint_names):
-        thr, unit = obs.thresholds[j], units[j]
+        thr, unit = thresholds[j], units[j]
         if contact.active[j]:
             extra = allowance[j] if allowance is not None else 0.0
             parts.append(f'{name} {r[j]:.3g} {unit} (threshold {thr:.3g}'

@@ -244,3 +244,24 @@ def test_bad_observer_settings_refuse_to_start(args, message):
     assert proc.returncode == 2, proc.stderr
     assert message in proc.stderr, proc.stderr
     assert 'Traceback' not in proc.stderr
+
+
+def test_the_contact_line_gives_the_threshold_in_effect(puma):
+    """With speed thresholds the line names the grown threshold, not a."""
+    from newton_euler_ros.core.observer import (contact_step,
+                                                initial_contact,
+                                                MomentumObserver)
+    from newton_euler_ros.nodes.node_observer import contact_text
+    obs = MomentumObserver(puma, thresholds=2.0, speed_thresholds=10.0,
+                           rest_reference=False)
+    contact = initial_contact(obs)
+    qd = np.full(6, 0.5)
+    r = np.array([0.0, 20.0, 0.0, 0.0, 0.0, 0.0])
+    for k in range(200):        # 0.2 s at 0.5 rad/s: the lag has settled
+        now = contact_step(obs, contact, r, None, 1e-3 * k, Q, qd)
+    assert now and contact.active[1]
+    grown = float(contact.threshold[1])
+    assert 2.0 + 10.0 * 0.5 * 0.99 < grown <= 2.0 + 10.0 * 0.5
+    text = contact_text(obs, contact, r, None)
+    assert f'joint2 20 N m (threshold {grown:.3g})' in text, text
+    assert 'threshold 2)' not in text
