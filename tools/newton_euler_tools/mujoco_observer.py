@@ -16,6 +16,7 @@
 The node's observer against MuJoCo's contacts, over DDS.
 
     python -m newton_euler_tools.mujoco_observer [--quick] [--out DIR]
+        [--real-time-factor X]
 
 Three ROS processes in a domain of their own (ROS_DOMAIN_ID and the next
 ids when it is set, else from 1 + pid % 100; discovery on localhost):
@@ -23,7 +24,8 @@ mujoco_sim_node with ``panda_mujoco_push`` (a Panda tracking a 0.6 Hz
 sinusoid while a pusher presses link 7 with 20 N through a MuJoCo
 contact), inverse_dynamics_node with its momentum observer on (wrench at
 link 7) and tracking_controller_node (PD plus the node's feedforward),
-all on the plant's simulated time.  A probe in this process records
+all on the plant's simulated time, the plant in lockstep (each tick
+waits for the command answering the last state).  A probe in this process records
 joint_states, /clock, the plant's true contact wrench at link 7
 (``/mujoco_sim_node/contact_wrenches/link7``), and the node's
 ``~/external_torque``, ``~/external_wrench`` and ``~/contact``.
@@ -75,13 +77,26 @@ QUICK_DURATION = 2.0        # s: the push (1.2 to 1.92 s) and its fading
 STARTUP_TIMEOUT = 120.0
 NO_THRESHOLD = 1.0e6        # N m: the free run reports no contact
 #: PD gains of the loop over DDS: the push scene's are made for a
-#: controller inside the physics step; over DDS each command comes some
-#: ticks late, and the wrist (0.005 kg m2 at joint 7) rings unless its
-#: bandwidth (kd / inertia) stays well below 1 / delay.  The library's
-#: feedforward does the tracking.
+#: controller inside each 1 ms physics step.  A driver at 500 Hz holds a
+#: command for a 2 ms tick and, in lockstep too, applies it one tick
+#: after its state: the scene's kd on the wrist (4 N m s/rad on 0.005 kg
+#: m2 at joint 7) would change its speed by 1.6 times itself in one tick,
+#: which no sampled loop survives.  The library's feedforward does the
+#: tracking.
 LOOP_GAINS = {'kp': [100.0] * 4 + [5.0, 5.0, 1.0],
               'kd': [10.0] * 4 + [0.5, 0.5, 0.1]}
-RTF = 0.2                   # the plant's pace: three nodes at 500 Hz
+#: the plant in lockstep: each tick waits for the command answering the
+#: last state (one tick of delay whatever the load: repeatable runs); a
+#: wait longer than this many wall-clock seconds (a node's first sample)
+#: is no loss of lockstep
+LOCKSTEP_WAIT = 10.0
+#: the plant's pace: lockstep needs a real-time factor above 0 here.  At
+#: 0 the brakes' ticks (before the first command) run at 500 Hz of wall
+#: clock whatever the nodes do; the observer node falls behind them, the
+#: controller, which keeps 32 states for its feedforward, answers none
+#: and the arm never starts.  At 0.25 (8 ms a tick) the node keeps up,
+#: and commands that answer late brakes' states collapse into one tick
+RTF = 0.25
 
 
 class Probe(Recorder):
@@ -144,6 +159,8 @@ def plant(scenes, pusher, label, domain, log_dir, rtf):
                  'newton_euler_ros.nodes.mujoco_sim_node',
                  ['-p', f'scene:={scenes[pusher][0]}',
                   '-p', 'wait_for_subscribers:=3',
+                  '-p', 'lockstep:=true',
+                  '-p', f'command_timeout:={LOCKSTEP_WAIT!r}',
                   '-p', f'real_time_factor:={rtf!r}'], domain, log_dir)
 
 
