@@ -58,6 +58,9 @@ def test_the_nodes_observer_feels_mujocos_pusher_over_dds(tmp_path):
     assert w['compared'] > 100 and w['missing'] == 0
     assert 15.0 < w['lagged_force_peak_n'] < 30.0      # the 20 N push
     assert w['worst_ratio'] <= 1.0
+    # MuJoCo's wrench is the tick's mean, from the scene replayed on the
+    # run's efforts: in lockstep the replay is the run itself
+    assert s['replay_max_position_error_rad'] < 1e-9
     assert s['false_contacts_push_run'] == []
     # at full speed: the sinusoid's 0.5 rad at 0.6 Hz is 1.9 rad/s
     assert s['max_speed_rad_s'] > 1.5
