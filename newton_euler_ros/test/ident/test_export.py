@@ -421,3 +421,9 @@ def test_errors_are_one_line(ur5, tmp_path, capsys):
                         '--overwrite'], capsys)
     assert code == 0, err
     assert 'inertia_parameters' in yaml.safe_load(out.read_text())
+
+
+def test_the_command_offers_the_formats_the_writer_has():
+    from newton_euler_ros import cli_export
+    from newton_euler_ros.ident import export
+    assert tuple(cli_export.FORMATS) == tuple(export.FORMATS)
