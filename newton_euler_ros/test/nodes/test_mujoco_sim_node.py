@@ -462,7 +462,10 @@ def test_a_scene_makes_the_plant_and_its_pusher_is_felt_on_the_topic(
         WrenchStamped, '/mujoco_sim_node/contact_wrenches/link7', 1000)
     try:
         run.wait_up(2)
-        assert start and start[-1].stamp.sec == start[-1].stamp.nanosec == 0
+        # the latched start can reach the probe after the first states
+        # (discovery of each topic is its own): wait for it
+        assert run.probe.spin_until(lambda: bool(start), 10.0)
+        assert start[-1].stamp.sec == start[-1].stamp.nanosec == 0
         np.testing.assert_array_equal(
             run.states[0].position, [0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8])
         run.pub.publish(command(np.zeros(7)))
