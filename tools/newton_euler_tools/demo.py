@@ -313,6 +313,16 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir,
             if time.monotonic() > end:
                 raise DemoError(f'[{label}] simulation did not reach '
                                 f't = {duration} s in time')
+        # on a loaded machine the controller can lag the stream: give it
+        # until as many commands as states up to t = duration are recorded
+        # (the plant runs on meanwhile; with feedforward some states stay
+        # unanswered, so this waits a few seconds at most)
+        states_in = sum(1 for s in recorder.states
+                        if -1e-9 <= s[0] - recorder.t0 <= duration + 1e-9)
+        caught_up = time.monotonic() + 3.0
+        while (len(recorder.commands) < states_in
+               and time.monotonic() < caught_up):
+            recorder.spin_once(0.05)
         # the controller first: then no command is in flight when the
         # recorder and the simulator give their counts
         status[controller.label] = controller.stop()
