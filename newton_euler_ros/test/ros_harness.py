@@ -145,6 +145,34 @@ class Probe:
             if time.monotonic() >= end:
                 raise TimeoutError(f'service {name} did not answer')
 
+    def handshake(self, publisher, message, answers, timeout=60.0,
+                  resend=0.5, settle=1.0):
+        """
+        Publish ``message`` until ``answers`` holds a reply with its stamp.
+
+        A subscription count above zero says only that the publisher has
+        matched the node's reader; until the node's reader has matched
+        the publisher too, what is published is lost (volatile, and the
+        reader does not know the writer yet).  One answered message
+        proves both directions, so a test's timed stream starts only
+        after it.  The message is sent again every ``resend`` seconds
+        with the same stamp; once one reply is in, the probe spins
+        ``settle`` seconds more so replies to the resends arrive too.
+        Returns the stamp, for the caller to leave those replies out.
+        """
+        stamp = message.header.stamp
+        end = time.monotonic() + timeout
+
+        def replied():
+            return any(m.header.stamp == stamp for m in answers)
+        while time.monotonic() < end:
+            publisher.publish(message)
+            if self.spin_until(replied, resend):
+                self.spin_for(settle)
+                return stamp
+        raise TimeoutError(f'no reply to the handshake on '
+                           f'{publisher.topic_name} within {timeout} s')
+
     def close(self):
         self.executor.shutdown()
         self.node.destroy_node()
