@@ -74,11 +74,10 @@ NO_THRESHOLD = 1.0e6        # N m: the free run reports no contact
 LOOP_GAINS = {'kp': [100.0] * 4 + [5.0, 5.0, 1.0],
               'kd': [10.0] * 4 + [0.5, 0.5, 0.1]}
 LOCKSTEP_WAIT = 10.0        # wall s a lockstep tick may wait (warm-up)
-#: the plant's pace, in lockstep.  At 0 the brakes' ticks run at 500 Hz
-#: of wall clock: the observer node falls behind and the controller
-#: (32 states kept for their feedforward) answers none.  At 0.25 the
-#: node keeps up; late answers to the brakes' states collapse in a tick.
-RTF = 0.25
+#: the plant's pace: 0, as fast as the lockstep loop answers (each tick
+#: waits for the command, which waits for the node's feedforward; the
+#: plant paces its braked ticks before the first command itself)
+RTF = 0.0
 
 
 class Probe(Recorder):
@@ -416,9 +415,9 @@ def data_path():
                 if os.path.isfile(os.path.join(d, f'{SCENE}.yaml')))
 
 
-def catch_up_end(release, free_release):
-    """When free motion counts: 10 time constants after a late release."""
-    return release + (10.0 / GAIN if release > free_release + 1e-9 else 0)
+def free_from(release):
+    """When free motion counts: 10 observer time constants after release."""
+    return release + 10.0 / GAIN
 
 
 def released(run):
@@ -461,7 +460,7 @@ def measure(data, out, log_dir, base, quick, rtf):
                 f'[free] the node observed only {100 * covered:.0f} % of '
                 'the joint states (it drops implausible speeds: the loop '
                 'fell behind and the arm rang?); thresholds from it would '
-                'mean nothing: run again with a lower --real-time-factor '
+                'mean nothing: run again with --real-time-factor 0.25 '
                 f'(logs in {log_dir})')
     except BaseException:
         sims[1].stop()
@@ -486,13 +485,13 @@ def measure(data, out, log_dir, base, quick, rtf):
     heard = len(episodes(push['contact']))
     reported = episodes(flags, onset)
     delay = reported[0] - onset if reported else math.inf
-    # free motion: release to onset, and once faded (10 time constants);
-    # a run released later than the free run (the first answer's time
-    # varies with load) starts behind its plan: once it has caught up
+    # free motion: from 10 time constants after the release (until then
+    # the residual still holds the brakes' torque, which the observer
+    # rightly sees as external) to the onset, and once the push faded
     settled = faded + 10.0 / GAIN
-    catch_up = catch_up_end(moving, start)
-    false = episodes(flags, catch_up, onset) + episodes(flags, settled)
-    braked = episodes(flags, -math.inf, moving)
+    free = free_from(moving)
+    false = episodes(flags, free, onset) + episodes(flags, settled)
+    braked = episodes(flags, -math.inf, free)
     replayed = len(episodes(flags))
     held = None
     if not quick:
@@ -500,7 +499,7 @@ def measure(data, out, log_dir, base, quick, rtf):
             scenes, plant(scenes, False, 'held_out', base + 2, log_dir, rtf),
             'held-out', duration, base + 2, log_dir, thresholds), duration)
         held = episodes(replay(scene, check, thresholds),
-                        catch_up_end(released(check), start))
+                        free_from(released(check)))
         heard += len(episodes(check['contact']))
         replayed += len(episodes(replay(scene, check, thresholds)))
     save(out, runs)
@@ -518,7 +517,7 @@ def measure(data, out, log_dir, base, quick, rtf):
         'false_contacts_push_run': false,
         'false_contacts_held_out': held,
         'contacts_while_braked': braked,
-        'catch_up_left_out_s': [moving, catch_up],
+        'brakes_fading_s': [moving, free],
         # ~/contact's changes to true as heard, and as replayed
         'contacts_heard': heard, 'contacts_replayed': replayed,
         'contact_heard_s': (episodes(push['contact'], onset) or [None])[0],

@@ -66,6 +66,8 @@ not touched.  All zero (the default): MuJoCo's state exactly.
 With ``lockstep``, once the brakes are released a tick advances only
 when a valid command came after the last joint state (a controller
 answering each state at the driver's rate, its deadline always met);
+while the brakes hold, the ticks come at most 20 a second of wall clock
+(``HELD_PACE``), so that a graph answering each state keeps up with them;
 after ``command_timeout`` seconds of wall clock without one the ticks go
 on without waiting until the next command.  With ``real_time_factor``
 0 as well, each command ticks at once: the loop runs as fast as the
@@ -113,6 +115,11 @@ from ..parameters import load_specs
 NAME = 'mujoco_sim_node'
 DIAGNOSTICS_PERIOD = 1.0    # wall-clock seconds between /diagnostics
 WARN_PERIOD = 2.0           # wall-clock seconds between bad-command logs
+#: lockstep, brakes on: wall-clock seconds at least between two ticks.
+#: Nothing paces those ticks (no command comes until the controller
+#: answers), and a graph that answers each state (a controller waiting
+#: for each state's feedforward) can fall behind them for good.
+HELD_PACE = 0.05
 # robot_state_publisher's QoS for robot_description: a late subscriber
 # still gets the last description, but only with the same durability
 DESCRIPTION_QOS = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
@@ -209,6 +216,7 @@ class MujocoSimNode(SharedGraphNode):
         self.lockstep = p['lockstep']
         self.fresh = False      # a valid command since the last state
         self._waiting = None    # wall time a lockstep wait began
+        self._held_tick = -math.inf     # wall time of the last held tick
 
         qos = qos_profile(100, 'reliable')
         self.state_pub = self.create_publisher(JointState, 'joint_states',
@@ -396,8 +404,14 @@ class MujocoSimNode(SharedGraphNode):
             plant.release()
             self.get_logger().info(
                 f'first command at t = {plant.time:.3f} s: brakes released')
-        if self.lockstep and not plant.held and not self._lockstep_ready():
-            return
+        if self.lockstep:
+            if plant.held:
+                now = time.monotonic()
+                if now - self._held_tick < HELD_PACE:
+                    return
+                self._held_tick = now
+            elif not self._lockstep_ready():
+                return
         self.fresh = False
         tau = self.tau
         if not plant.held and not self.stale and \

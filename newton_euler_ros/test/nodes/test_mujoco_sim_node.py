@@ -34,6 +34,9 @@ mujoco_sim_node as a process: the MuJoCo plant over real DDS.
   it up against gravity at rest.
 - A bad robot_file or a wrong number of initial positions: one line, exit
   status 2; so is a negative or NaN sensor noise.
+- Lockstep: brakes on, at most 20 ticks a second of wall clock (nothing
+  else paces them); once released, one tick per command and none
+  without.
 - Sensor noise (``noise.*``): zero gives MuJoCo's state exactly; on, the
   published states scatter about it with the requested standard
   deviations (to sampling error), the plant itself untouched.
@@ -42,6 +45,7 @@ import math
 import os
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -522,3 +526,44 @@ def test_sensor_noise_off_is_mujoco_on_has_the_asked_deviation(tmp_path):
         assert abs(err.mean()) < 5 * s / math.sqrt(err.size), name
         # fresh noise every tick, every joint: no two samples alike
         assert np.unique(err).size == err.size, name
+
+
+def test_lockstep_paces_the_braked_ticks_and_ticks_once_per_command(
+        tmp_path):
+    """
+    Before the first command nothing paces a lockstep plant's ticks: at
+    its full rate (real-time factor 0) a graph that answers every state
+    could fall behind them for good, so the plant holds them to at most
+    20 a second of wall clock (simulated time still runs a tick each).
+    Once released, each command makes exactly one tick.
+    """
+    run = Session(tmp_path, 51, robot_file='panda', initial_positions=Q0,
+                  rate=500.0, lockstep=True, real_time_factor=0.0,
+                  command_timeout=30.0)
+    try:
+        run.wait_up(2)
+        count, start = len(run.states), time.monotonic()
+        run.probe.spin_for(1.0)
+        held = len(run.states) - count
+        elapsed = time.monotonic() - start
+        assert 1 <= held <= elapsed / 0.05 + 2, (held, elapsed)
+        stamps = np.array([t_of(m) for m in run.states])
+        np.testing.assert_allclose(np.diff(stamps), 0.002, atol=1e-6)
+        for msg in run.states:
+            np.testing.assert_array_equal(msg.position, Q0)
+        # the first command releases the brakes (a held tick may come
+        # before it); from then on one tick per command
+        run.pub.publish(command(np.zeros(7)))
+        assert run.probe.spin_until(lambda: not np.array_equal(
+            run.states[-1].position, Q0), 10.0), run.node.log()
+        run.probe.spin_for(0.1)
+        for k in range(20):
+            count = len(run.states)
+            run.pub.publish(command(np.zeros(7)))
+            assert run.probe.spin_until(lambda: len(run.states) > count,
+                                        10.0), run.node.log()
+            run.probe.spin_for(0.05)        # no tick without a command
+            assert len(run.states) == count + 1, (k, run.node.log())
+    finally:
+        log = run.close()
+    assert 'brakes released' in log, log
