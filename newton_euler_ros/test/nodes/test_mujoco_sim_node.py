@@ -531,6 +531,8 @@ def test_sensor_noise_off_is_mujoco_on_has_the_asked_deviation(tmp_path):
 def test_lockstep_paces_the_braked_ticks_and_ticks_once_per_command(
         tmp_path):
     """
+    Lockstep: braked ticks at most 20 a second, then one per command.
+
     Before the first command nothing paces a lockstep plant's ticks: at
     its full rate (real-time factor 0) a graph that answers every state
     could fall behind them for good, so the plant holds them to at most
