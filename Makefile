@@ -42,6 +42,10 @@ export ROS_LOG_DIR := $(CURDIR)/build/ros_log
 # numba, scipy and rclpy from source again, about 1.5 s of CPU each.
 unexport PYTHONDONTWRITEBYTECODE
 export PYTHONPYCACHEPREFIX := $(CURDIR)/build/pycache
+# One BLAS thread per process: the two test workers fill both cores, and
+# OpenBLAS threads on a busy core wait on each other (20x slower fits; see
+# newton_euler_ros/__init__.py).
+export OPENBLAS_NUM_THREADS ?= 1
 export NUMBA_CACHE_DIR ?= $(or $(XDG_CACHE_HOME),$(HOME)/.cache)/newton_euler_ros/numba
 
 .PHONY: setup test demo demo-pick demo-identify demo-identify-mujoco bench bench-identify latency \

@@ -20,6 +20,7 @@ nothing from ROS; the ROS adapters (nodes, message conversion) sit beside
 it.
 """
 import os
+import sys
 
 __version__ = '0.1.0'
 
@@ -30,3 +31,14 @@ __version__ = '0.1.0'
 os.environ.setdefault('NUMBA_CACHE_DIR', os.path.join(
     os.environ.get('XDG_CACHE_HOME') or os.path.join(
         os.path.expanduser('~'), '.cache'), 'newton_euler_ros', 'numba'))
+
+# numpy's and scipy's OpenBLAS runs every matrix operation on a thread per
+# core.  The matrices here are small (at most a few hundred columns), and
+# on a machine whose cores are busy (a robot computer running its stack)
+# those threads wait on each other: with the other core busy, identifying
+# a dual-arm current recording took 509 s with two threads and 23 s with
+# one (docs/identification.md).  One thread, unless the caller chose; it
+# takes effect only where numpy is not loaded yet (the console scripts,
+# ``python -m newton_euler_ros...``), and child processes inherit it.
+if 'numpy' not in sys.modules:
+    os.environ.setdefault('OPENBLAS_NUM_THREADS', '1')

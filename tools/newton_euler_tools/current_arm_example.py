@@ -222,23 +222,30 @@ def friction(arm, qd, dt, rng):
     d = arm.drives
     fc, fs = np.asarray(d['coulomb']), np.asarray(d['static'])
     vs, delta = d['stribeck_speed'], d['bristle']
-    m = qd.shape[0]
-    out = np.empty_like(qd)
     settle = rng.uniform(-0.3, 1.0, qd.shape)
     walk = rng.normal(0.0, REST_DRIFT * math.sqrt(dt), qd.shape) * fs
-    f = np.zeros(6)
-    was_moving = np.zeros(6, dtype=bool)
-    for k in range(m):
-        v = qd[k]
-        moving = v != 0.0
-        fss = np.sign(v) * (fc + (fs - fc) * np.exp(-(v / vs) ** 2))
-        a = np.exp(-np.abs(v) * dt / delta)
-        stopped = ~moving & was_moving
-        f = np.where(moving, fss + (f - fss) * a,
-                     np.clip(np.where(stopped, f * settle[k], f) + walk[k],
-                             -fs, fs))
-        was_moving = moving
-        out[k] = f
+    # everything but the state, for every sample at once; the state
+    # recursion then runs per joint on plain floats
+    moving = qd != 0.0
+    fss = np.sign(qd) * (fc + (fs - fc) * np.exp(-(qd / vs) ** 2))
+    a = np.exp(-np.abs(qd) * dt / delta)
+    stopped = ~moving
+    stopped[1:] &= moving[:-1]
+    stopped[0] = False
+    out = np.empty_like(qd)
+    for j in range(qd.shape[1]):
+        f, hi, lo = 0.0, float(fs[j]), -float(fs[j])
+        column = zip(moving[:, j].tolist(), fss[:, j].tolist(),
+                     a[:, j].tolist(), stopped[:, j].tolist(),
+                     settle[:, j].tolist(), walk[:, j].tolist())
+        values = []
+        for move, target, decay, stop, scale, step in column:
+            if move:
+                f = target + (f - target) * decay
+            else:
+                f = min(max((f * scale if stop else f) + step, lo), hi)
+            values.append(f)
+        out[:, j] = values
     return out
 
 

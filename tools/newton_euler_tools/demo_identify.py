@@ -293,13 +293,67 @@ TOLD = f'{PAYLOAD["mass"]:g} kg payload, estimate applied'
 
 class PayloadSteps:
     """
-    Steps 5 and 6 of the loop, the same on either plant.
+    The identified runs' start and steps 5 and 6, the same on either plant.
 
     A loop has ``steps``, ``identified``, ``bag2`` (the payload
-    recording), ``last`` (the run the estimate is applied to), ``segment``
-    and ``path``; ``last_seconds()`` and ``keep_told(run)`` are the
-    plant's own.
+    recording), ``last`` (the run the estimate is applied to), ``segment``,
+    ``live``, ``out`` and ``args``; the steps 1 to 4, ``all_runs()``,
+    ``last_seconds()`` and ``keep_told(run)`` are the plant's own.
     """
+
+    def run(self):
+        """All six steps; DemoError if one fails (every run stopped)."""
+        try:
+            self.excite()
+            self.record_published()
+            self.identify()
+            self.record_identified()
+            self.estimate_payload()
+            self.apply_estimate()
+            for r in self.all_runs():
+                r.close()
+        finally:
+            for item in reversed(self.live):
+                item.abort()
+
+    def path(self, name):
+        """Return the path of a file in the demo's output folder."""
+        return os.path.join(self.out, name)
+
+    def plant_files(self, plant_urdf):
+        """
+        Copy the published URDF and write the plant's.
+
+        ``plant_urdf(text, links, seed)`` makes the plant's text; returns
+        (published model, plant model, plant URDF path).
+        """
+        self.published = self.path('panda_published.urdf')
+        shutil.copyfile(panda_path(), self.published)
+        nominal = quiet_load(self.published)
+        with open(self.published, encoding='utf-8') as f:
+            text = f.read()
+        real = self.path('panda_real.urdf')
+        with open(real, 'w', encoding='utf-8') as f:
+            f.write(plant_urdf(text, set(nominal.info['urdf']['links']),
+                               self.args.seed))
+        return nominal, quiet_load(real), real
+
+    def start_identified(self, runs, plans, which):
+        """
+        Start ``runs`` (on ``plans``) with the identified URDF.
+
+        The last run is described too, to be ready when step 6 comes.
+        """
+        with open(self.identified, encoding='utf-8') as f:
+            identified_text = f.read()
+        for r in (*runs, self.last):
+            r.describe(identified_text)
+        wait_until(runs, lambda: all(r.ready() for r in runs),
+                   f'the nodes of the {which} runs')
+        for r, plan in zip(runs, plans):
+            r.go(plan)
+        wait_until(runs, lambda: all(r.begun() for r in runs),
+                   'the simulation start')
 
     def estimate_payload(self):
         """5: ``payload --json`` on the payload recording."""
@@ -353,10 +407,6 @@ class Loop(PayloadSteps):
         self.runs = {}
         self.truth = {}
 
-    def path(self, name):
-        """Return the path of a file in the demo's output folder."""
-        return os.path.join(self.out, name)
-
     def start_run(self, label, **kw):
         """Start a run's nodes in the next ROS domain."""
         run = LoopRun(label, self.scene, next(self.domains), self.log_dir,
@@ -368,16 +418,7 @@ class Loop(PayloadSteps):
         """1: the plant's files, the first run's nodes, ``excite``."""
         self.steps.begin('excite', '[1/6] newton-euler excite; the nodes '
                          'of the first run start meanwhile')
-        self.published = self.path('panda_published.urdf')
-        shutil.copyfile(panda_path(), self.published)
-        nominal = quiet_load(self.published)
-        with open(self.published, encoding='utf-8') as f:
-            text = f.read()
-        real = self.path('panda_real.urdf')
-        with open(real, 'w', encoding='utf-8') as f:
-            f.write(real_plant_urdf(text, set(nominal.info['urdf']['links']),
-                                    self.args.seed))
-        truth_model = quiet_load(real)
+        nominal, truth_model, real = self.plant_files(real_plant_urdf)
         self.scene = self.path('panda_real.yaml')
         write_scene(self.scene, real, self.duration)
         self.first = self.start_run('published', urdf=self.published)
@@ -434,17 +475,8 @@ class Loop(PayloadSteps):
             'the identified URDF (robot_description) + drive compensation: '
             f'as is, and with {PAYLOAD["mass"]:g} kg picked up (node not '
             'told), recorded')
-        with open(self.identified, encoding='utf-8') as f:
-            identified_text = f.read()
-        for r in (second, third, self.last):
-            r.describe(identified_text)
-        wait_until([second, third], lambda: second.ready() and third.ready(),
-                   'the nodes of the second and third runs')
-        second.go(self.segment)
-        third.go(self.segment)
-        wait_until([second, third],
-                   lambda: all([second.begun(), third.begun()]),
-                   'the simulation start')
+        self.start_identified((second, third), (self.segment, self.segment),
+                              'second and third')
         drive([second, third], self.duration)
         self.bag2 = self.path('payload_recording')
         self.runs[IDENTIFIED] = second.finish(self.duration)
@@ -462,21 +494,6 @@ class Loop(PayloadSteps):
     def all_runs(self):
         """Return every run, in the order they started."""
         return (self.first, self.second, self.third, self.last)
-
-    def run(self):
-        """All six steps; DemoError if one fails (every run stopped)."""
-        try:
-            self.excite()
-            self.record_published()
-            self.identify()
-            self.record_identified()
-            self.estimate_payload()
-            self.apply_estimate()
-            for r in self.all_runs():
-                r.close()
-        finally:
-            for item in reversed(self.live):
-                item.abort()
 
 
 def loop_parser(name, doc, quick):

@@ -42,16 +42,15 @@ state, into ``/effort_controller/commands``).
    again.
 """
 import os
-import shutil
 
 from .demo_identify import (ARMATURE, COULOMB, IDENTIFIED, KD, KP,
                             load_segment, newton_euler, PAYLOAD,
-                            PayloadSteps, PUBLISHED, quiet_load, START,
+                            PayloadSteps, PUBLISHED, START,
                             Steps, TOLD, true_torques, UNTOLD, VISCOUS,
                             warm_excite)
 from .demo_identify_report import payload_line
 from .demo_identify_runs import drive, LoopRun, wait_until
-from .ident_example import BASE, panda_path, TIP
+from .ident_example import BASE, TIP
 from .mujoco_identify import held_out_error
 from .mujoco_identify_plant import NOISE, PHYSICS_STEP, plant_urdf
 
@@ -127,10 +126,6 @@ class MujocoLoop(PayloadSteps):
         self.runs, self.segments, self.truth = {}, {}, {}
         self.noise = dict(NOISE, seed=args.seed)
 
-    def path(self, name):
-        """Return the path of a file in the demo's output folder."""
-        return os.path.join(self.out, name)
-
     def start_run(self, label, scene, **kw):
         """Start a run's nodes in the next ROS domain."""
         run = LoopRun(label, scene, next(self.domains), self.log_dir,
@@ -143,16 +138,7 @@ class MujocoLoop(PayloadSteps):
         self.steps.begin('excite', '[1/6] newton-euler excite (twice: '
                          'identification, held out); the nodes of the '
                          'first two runs start meanwhile')
-        self.published = self.path('panda_published.urdf')
-        shutil.copyfile(panda_path(), self.published)
-        nominal = quiet_load(self.published)
-        with open(self.published, encoding='utf-8') as f:
-            text = f.read()
-        real = self.path('panda_real.urdf')
-        with open(real, 'w', encoding='utf-8') as f:
-            f.write(plant_urdf(text, set(nominal.info['urdf']['links']),
-                               self.args.seed))
-        truth_model = quiet_load(real)
+        nominal, truth_model, real = self.plant_files(plant_urdf)
         self.scene = self.path('panda_real.yaml')
         write_mujoco_scene(self.scene, real)
         self.payload_scene = self.path('panda_real_payload.yaml')
@@ -239,17 +225,8 @@ class MujocoLoop(PayloadSteps):
             'the identified URDF (robot_description) + drive compensation: '
             f'the held-out trajectory, and with {PAYLOAD["mass"]:g} kg held '
             '(node not told), recorded')
-        with open(self.identified, encoding='utf-8') as f:
-            identified_text = f.read()
-        for r in (ident, untold, self.last):
-            r.describe(identified_text)
-        wait_until([ident, untold], lambda: ident.ready() and untold.ready(),
-                   'the nodes of the third and fourth runs')
-        ident.go(self.heldout)
-        untold.go(self.segment)
-        wait_until([ident, untold],
-                   lambda: all([ident.begun(), untold.begun()]),
-                   'the simulation start')
+        self.start_identified((ident, untold), (self.heldout, self.segment),
+                              'third and fourth')
         drive([ident], self.duration(self.heldout))
         drive([untold], self.duration(self.segment))
         self.bag2 = self.path('payload_recording')
@@ -326,21 +303,6 @@ class MujocoLoop(PayloadSteps):
     def all_runs(self):
         """Return every run, in the order they started."""
         return (self.pub, self.pub_held, self.ident, self.untold, self.last)
-
-    def run(self):
-        """All six steps; DemoError if one fails (every run stopped)."""
-        try:
-            self.excite()
-            self.record_published()
-            self.identify()
-            self.record_identified()
-            self.estimate_payload()
-            self.apply_estimate()
-            for r in self.all_runs():
-                r.close()
-        finally:
-            for item in reversed(self.live):
-                item.abort()
 
 
 __all__ = ['HELDOUT_IDENTIFIED', 'HELDOUT_PUBLISHED', 'IDENTIFIED',

@@ -30,6 +30,11 @@ A block that cannot run here says so in the line before its fence:
 - ``<!-- doc-test: stop after N s -->``: a command that runs until
   stopped (a node): it must still be running, or have exited 0, after N
   seconds; it then gets SIGINT and must exit 0.
+- ``<!-- doc-test: stop at "TEXT" (at most N s) -->``: the same, but
+  stopped as soon as it has shown it is up: it must print a line
+  containing TEXT (the last line a node logs at start-up) within N
+  seconds, without exiting non-zero; a second later it gets SIGINT and
+  must exit 0.
 
 Usage synopses with [optional] parts belong in ```text blocks, which are
 not run; a bash block must not contain such brackets (checked).
@@ -39,6 +44,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 from newton_euler_tools.processes import ros_env
@@ -132,6 +138,45 @@ def _stop_after(proc, seconds, where):
     return proc.returncode, out
 
 
+STOP_AT = re.compile(r'stop at "([^"]+)" \(at most (\d+(?:\.\d+)?) s\)$')
+SETTLE = 1.0    # seconds between the ready line and SIGINT
+
+
+def _stop_at(proc, text, seconds, where):
+    """Stop ``proc`` a moment after it prints ``text``; (status, output)."""
+    lines, seen = [], threading.Event()
+
+    def read():
+        for line in proc.stdout:
+            lines.append(line)
+            if text in line:
+                seen.set()
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    deadline = time.monotonic() + seconds
+    while (not seen.is_set() and proc.poll() is None
+           and time.monotonic() < deadline):
+        seen.wait(0.1)
+    if seen.is_set() and proc.poll() is None:
+        time.sleep(SETTLE)
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGINT)
+    try:
+        proc.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        reader.join(5)
+        raise AssertionError(f'{where}: did not stop on SIGINT:\n'
+                             f'{"".join(lines)[-3000:]}')
+    reader.join(5)
+    out = ''.join(lines)
+    if proc.returncode == 0:
+        assert seen.is_set(), (f'{where}: no line with {text!r} within '
+                               f'{seconds} s:\n{out[-3000:]}')
+    return proc.returncode, out
+
+
 def run_page(page, cwd, passed=None):
     """
     Run every block of one page in order; return how many ran.
@@ -165,8 +210,12 @@ def run_page(page, cwd, passed=None):
             stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
             start_new_session=True, stdin=subprocess.DEVNULL)
         m = re.match(r'stop after (\d+(?:\.\d+)?) s', directive or '')
+        at = STOP_AT.match(directive or '')
         if m:
             code, out = _stop_after(proc, float(m.group(1)), where)
+        elif at:
+            code, out = _stop_at(proc, at.group(1), float(at.group(2)),
+                                 where)
         else:
             assert directive is None, f'{where}: unknown directive {directive!r}'
             try:

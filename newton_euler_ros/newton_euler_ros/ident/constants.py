@@ -51,18 +51,27 @@ found.
 import numpy as np
 
 from . import effort
-from .problem import stacked
 from .reduce import IdentificationError
 
 PRIOR_WEIGHT = 1e-6
 
 
 class _Projected:
-    """The effort-unit residual as a function of the constants."""
+    """
+    The effort-unit residual as a function of the constants.
+
+    Joint j's rows of a recording are R_j (G x + h) with h = -K_j e_pb
+    (``layout.coefficients``): T_j x - K_j r_j, with T_j = R_j G and r_j
+    R_j's effort column, both independent of K.  Each joint's [T_j, r_j]
+    is factored once, on the columns it touches (a joint's torque depends
+    on the bodies below it: on a dual-arm tree most columns are zero), to
+    F_j = Q_j^T [T_j, r_j]; a fixed rotation of the joint's rows, so
+    every evaluation solves the same least-squares problem (and returns
+    a residual of the same norm) on a fraction of the rows.
+    """
 
     def __init__(self, recordings, layout, width, sigma_e, lam, D, theta0,
                  mass):
-        self.args = (recordings, layout, width)
         self.sigma_e = sigma_e
         self.layout = layout
         p = layout.p_theta
@@ -74,31 +83,46 @@ class _Projected:
         self.mcol = layout.pay.start if mass is not None else None
         self.mass = mass
         self.rows = sum(int(r.part('all').rows.sum()) for r in recordings)
+        self.blocks = []            # (joint, its columns, F_j)
+        for rec in recordings:
+            red = rec.part('all')
+            pb = layout.bag_columns(rec.loaded)
+            for j in range(layout.n):
+                G, _ = layout.coefficients(j, width, rec.loaded,
+                                           np.ones(layout.n))
+                T = red.R[j] @ G
+                cols = np.flatnonzero(np.any(T != 0.0, axis=0))
+                M = np.column_stack([T[:, cols], red.R[j][:, pb]])
+                F = np.linalg.qr(M, mode='r')
+                self.blocks.append((j, cols, F))
 
     def solve(self, K):
         """Return (x, residual vector) at constants K."""
-        recordings, layout, width = self.args
-        d = layout.size
+        d = self.layout.size
         w = 1.0 / (self.sigma_e * K)
-        Aug, _ = stacked(recordings, 'all', layout, width, w, K)
+        scale = 1.0 / np.sqrt(max(self.rows, 1))
+        A = np.zeros((sum(F.shape[0] for _, _, F in self.blocks), d + 1))
+        at = 0
+        for j, cols, F in self.blocks:
+            rows = slice(at, at + F.shape[0])
+            A[rows, cols] = w[j] * F[:, :-1]
+            A[rows, d] = w[j] * K[j] * F[:, -1]
+            at += F.shape[0]
+        Aug = np.linalg.qr(A, mode='r')[:d + 1] * scale
         M = np.vstack([Aug[:d, :d], self.prior])
         rhs = np.concatenate([Aug[:d, d], self.prior_z])
         x = np.zeros(d)
-        cols = np.arange(d)
+        free = np.arange(d)
         if self.mcol is not None:
             x[self.mcol] = self.mass
             rhs = rhs - M[:, self.mcol] * self.mass
-            cols = cols[cols != self.mcol]
-        x[cols], *_ = np.linalg.lstsq(M[:, cols], rhs, rcond=1e-12)
-        # the residual from the recordings' own factors: a smooth function
-        # of K (the stacked QR's rows may change sign from one K to the next)
+            free = free[free != self.mcol]
+        x[free], *_ = np.linalg.lstsq(M[:, free], rhs, rcond=1e-12)
+        # the residual from the fixed factors: a smooth function of K (the
+        # stacked QR's rows may change sign from one K to the next)
         parts = [self.prior @ x - self.prior_z]
-        for rec in recordings:
-            red = rec.part('all')
-            scale = 1.0 / np.sqrt(max(self.rows, 1))
-            for j in range(layout.n):
-                G, h = layout.coefficients(j, width, rec.loaded, K)
-                parts.append(w[j] * scale * (red.R[j] @ (G @ x + h)))
+        for j, cols, F in self.blocks:
+            parts.append(w[j] * scale * (F[:, :-1] @ x[cols] - K[j] * F[:, -1]))
         return x, np.concatenate(parts)
 
 

@@ -168,7 +168,10 @@ def test_subscribes_to_joint_states_once_its_peers_are_matched(
             probe.publisher(JointState, '/inverse_dynamics_node/torques')
             probe.collect(JointTrajectory, '/inverse_dynamics_node/reference')
         assert probe.spin_until(subscribed, 10.0), node.log()
-        assert 'peers matched' in node.log()
+        # the log line follows the subscription (CI read the log between
+        # the two once)
+        assert probe.spin_until(lambda: 'peers matched' in node.log(),
+                                10.0), node.log()
     finally:
         other.close()
         probe.close()
