@@ -126,7 +126,8 @@ def compile_arrays(model, m=Float64Math):
     Compile a model into its kernel arrays, in the number type of ``m``.
 
     Returns ``(links, frames)`` as nested lists (``links``: nb rows of
-    ``K.L_WIDTH``; ``frames``: ``K.F_ROWS`` rows of 12).  See
+    ``K.L_WIDTH``, filled by the field names of ``K.LINKS``, the one
+    declaration of its columns; ``frames``: ``K.F_ROWS`` rows of 12).  See
     ``model``'s docstring for the kernel frames: row j holds joint j's
     placement P_j = B_lambda(j) Pre_j A_j (B_k = A_k^T Post_k, the pose of
     link frame k in kernel frame k, identity for the base), the link's
@@ -156,22 +157,21 @@ def compile_arrays(model, m=Float64Math):
         com = [t[i] + pB[i] for i in range(3)]
         inertia = [[m.num(v) for v in row] for row in model.inertia[j]]
         inertia = _mul(_mul(RB, inertia), _transpose(RB))
-        row = [z] * K.L_WIDTH
-        row[K.L_TYPE] = m.num(0.0 if model.joint_types[j] == REVOLUTE
-                              else 1.0)
-        row[K.L_R:K.L_R + 9] = [x for r in P[0] for x in r]
-        row[K.L_P:K.L_P + 3] = P[1]
-        row[K.L_MASS] = m.num(model.mass[j])
-        row[K.L_COM:K.L_COM + 3] = com
-        row[K.L_INERTIA:K.L_INERTIA + 9] = [x for r in inertia for x in r]
-        row[K.L_BODY:K.L_BODY + 9] = [x for r in RB for x in r]
-        row[K.L_BODY + 9:K.L_BODY + 12] = pB
         mim = model.mimic[j]
-        row[K.L_PARENT] = m.num(float(parents[j]))
-        row[K.L_LEAD] = m.num(float(coord[j]))
-        row[K.L_MULT] = m.num(1.0 if mim is None else mim[1])
-        row[K.L_OFFSET] = m.num(0.0 if mim is None else mim[2])
-        row[K.L_STORE] = m.num(1.0 if store[j] else 0.0)
+        row = K.LINKS.row(
+            z,
+            type=m.num(0.0 if model.joint_types[j] == REVOLUTE else 1.0),
+            r=[x for r in P[0] for x in r],
+            p=P[1],
+            mass=m.num(model.mass[j]),
+            com=com,
+            inertia=[x for r in inertia for x in r],
+            body=[x for r in RB for x in r] + list(pB),
+            parent=m.num(float(parents[j])),
+            lead=m.num(float(coord[j])),
+            mult=m.num(1.0 if mim is None else mim[1]),
+            offset=m.num(0.0 if mim is None else mim[2]),
+            store=m.num(1.0 if store[j] else 0.0))
         links.append(row)
     tool_body = -1 if model.tool_body is None else model.tool_body
     on = B[tool_body] if tool_body >= 0 else _identity(m)

@@ -22,6 +22,7 @@ failing row with its code in ``status[0]`` (the codes that
 ``calling.status_error`` decodes).
 """
 import inspect
+import os
 
 from newton_euler_ros.core import kernels as K
 from newton_euler_ros.core import load_robot, Workspace
@@ -108,10 +109,40 @@ def test_batch_loops_return_the_first_failing_row():
                                        ws.status) == -1
 
 
-def test_the_generated_text_is_kept_and_compiled_at_its_row_step():
+def test_the_entry_points_are_the_checked_in_file_compiled():
     text = generate.SOURCES['run_gravity_torques_batch']
     assert 'gravity_torques_row(links, frames, Q[k], ws, TAU[k])' in text
     code = K.run_gravity_torques.py_func.__code__
-    row = K.entry.gravity_torques_row.py_func.__code__
-    assert code.co_filename == row.co_filename
-    assert code.co_firstlineno == row.co_firstlineno
+    assert code.co_filename == os.path.join(generate.HERE, 'entries.py')
+    assert K.run_gravity_torques.py_func.__module__.endswith('.entries')
+    for name, kernel in K.RUN.items():      # each in the file it belongs to
+        assert os.path.basename(kernel.py_func.__code__.co_filename) == \
+            generate.module_of(name)
+
+
+def test_the_checked_in_entries_files_are_what_the_generator_writes():
+    """Regenerate after editing entry.py: ``generate --write``."""
+    written = generate.render()
+    assert sorted(map(os.path.basename, written)) == sorted(generate.FILES)
+    for path, text in written.items():
+        with open(path, encoding='utf-8') as fh:
+            checked_in = fh.read()
+        assert checked_in == text, (
+            f'{path} is stale: run {generate.COMMAND}')
+    assert generate.main(['--check']) == 0
+
+
+def test_an_edited_row_step_without_regenerating_is_caught():
+    with open(generate.ENTRY_FILE, encoding='utf-8') as fh:
+        source = fh.read()
+    edited = source.replace('def gravity_torques_row(links, frames, q, ws, '
+                            'tau):', 'def gravity_torques_row(links, '
+                            'frames, q, qd, ws, tau):')
+    assert edited != source
+    assert generate.render(edited) != generate.render(source)
+    assert 'if qd.shape[0] != n:' in generate.sources(edited)[
+        'run_gravity_torques']
+    renamed = source.replace("('run_link_poses', link_poses_row)",
+                             "('run_link_poses', link_pose_row)")
+    with pytest.raises(ValueError, match='no row step link_pose_row'):
+        generate.render(renamed)

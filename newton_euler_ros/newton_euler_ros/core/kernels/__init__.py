@@ -40,12 +40,17 @@ file                   what it holds
                        drive columns
 ``cholesky.py``        Cholesky solve
 ``status.py``          finiteness checks and status codes in the kernels
-``layout.py``          every array column by name (``L_*``, ``F_*``,
-                       ``W_*``, ``A_*``, ``CW_*``), flags, status codes
-``entry.py``           what Python calls: each term once, as its row step,
-                       and one registration making its entry point and
-                       batch loop
-``generate.py``        writes those: size and finiteness checks, the loop
+``layout.py``          every array column by name, each array's columns
+                       one declaration (``LINKS``: ``L_*``; ``WS``: ``W_*``;
+                       ``AW``, ``CW``, ``DW``, ...), flags, status codes
+``entry.py``           each term once, as its row step, and the table of
+                       entry points (``ENTRIES``)
+``entries.py``         what Python calls: the entry points and batch loops
+                       (size and finiteness checks, the loop), GENERATED
+                       from ``entry.py`` by ``generate.py`` and checked in
+                       (``entries_derivatives.py``: the derivatives)
+``generate.py``        writes ``entries.py`` (``python -m
+                       newton_euler_ros.core.kernels.generate --write``)
 ``_jit.py``            ``njit``, the entry options, on-disk caching
 =====================  ====================================================
 
@@ -67,29 +72,33 @@ import os
 import sys
 import types
 
-from . import entry as _entry
+from . import entries as _entries
+from . import entries_derivatives as _entries_derivatives
 from ._jit import ENTRY
 from .aba import articulated_body
 from .cholesky import cholesky_solve
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH,
-                     C_HALF, C_ONE, C_ZERO, CONSTANTS, CS_BC, CS_H, CS_IC,
-                     CW_BCA, CW_F1, CW_F2, CW_G, CW_I, CW_ICA, CW_OW, CW_RW,
-                     CW_S, CW_SD, CW_V, CW_WIDTH, DW_WIDTH, F_BASE, F_CONST,
-                     F_GRAV, F_ROWS, F_TOOL, F_TREE, flags, GRAVITY, L_BODY, L_COM,
-                     L_INERTIA, L_LEAD, L_MASS, L_MULT, L_OFFSET, L_P,
+from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, AW,
+                     C_HALF, C_ONE, C_ZERO, Columns, CONST, CONSTANTS, CS,
+                     CS_BC, CS_H, CS_IC, CW, CW_BCA, CW_F1, CW_F2, CW_G, CW_I,
+                     CW_ICA, CW_OW, CW_RW, CW_S, CW_SD, CW_V, CW_WIDTH,
+                     DECLARATIONS, DS, DW, DW_WIDTH, F_BASE, F_CONST, F_GRAV,
+                     F_ROWS, F_TOOL, F_TREE, flags, FRAMES, GRAVITY, L_BODY,
+                     L_COM, L_INERTIA, L_LEAD, L_MASS, L_MULT, L_OFFSET, L_P,
                      L_PARENT, L_R, L_STORE, L_TYPE, L_WIDTH, LINK_WRENCHES,
-                     MIMIC, NONFINITE, OVERFLOW, pack, SINGULAR, SIZE,
-                     T_BRANCHED, T_NQ, T_TOOL, VELOCITY, W_ACC, W_CT, W_DD,
-                     W_F, W_N, W_P, W_R, W_ST, W_WIDTH, W_X, WRENCH_BASE,
-                     WRENCH_BITS, WRENCH_EE, WRENCH_NONE, WRENCH_SHIFT)
+                     LINKS, MIMIC, NONFINITE, OVERFLOW, pack, SINGULAR, SIZE,
+                     T_BRANCHED, T_NQ, T_TOOL, TREE, VELOCITY, W_ACC, W_CT,
+                     W_DD, W_F, W_N, W_P, W_R, W_ST, W_WIDTH, W_X, WRENCH_BASE,
+                     WRENCH_BITS, WRENCH_EE, WRENCH_NONE, WRENCH_SHIFT, WS)
 from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
                            momentum_terms, recursion, unit_columns)
 from .status import check_finite, first_nonfinite, round_into
 
 __all__ = [
+    'AW', 'Columns', 'CONST', 'CS', 'CW', 'DECLARATIONS', 'DS', 'DW',
+    'FRAMES', 'LINKS', 'TREE', 'WS',
     'A_A', 'A_C', 'A_D', 'A_IA', 'A_PA', 'A_U', 'A_UU', 'A_V', 'A_WIDTH',
     'articulated_body', 'C_HALF', 'C_ONE', 'C_ZERO', 'check_finite',
     'cholesky_solve', 'CONSTANTS', 'coriolis_matrix_columns',
@@ -109,17 +118,17 @@ __all__ = [
     'WRENCH_SHIFT',
 ]
 
-# every entry point of entry.py (``run_<term>``, ``run_<term>_batch``):
-# registering a term there is all it takes to export it from here
-RUN = {name: f for name, f in vars(_entry).items()
-       if name.startswith('run_')}
+# every entry point of entries*.py (``run_<term>``, ``run_<term>_batch``):
+# a line in entry.ENTRIES, then regenerating, is all it takes to export it
+RUN = {name: f for module in (_entries, _entries_derivatives)
+       for name, f in vars(module).items() if name.startswith('run_')}
 globals().update(RUN)
 __all__ += sorted(RUN)
 
 # the kernel files in the order they import each other
 MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
            'newton_euler', 'crba', 'coriolis', 'aba', 'derivatives',
-           'regressor', 'generate', 'entry')
+           'regressor', 'entry', 'entries', 'entries_derivatives')
 _DIR = os.path.dirname(os.path.abspath(__file__))
 
 

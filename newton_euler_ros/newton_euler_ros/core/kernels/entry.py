@@ -13,51 +13,45 @@
 # limitations under the License.
 
 """
-Entry points: what Python calls, each term written once as its row step.
+Row steps: each term written once, on one state; the entry points' table.
 
 A term is its *row step*, ``<term>_row(links, frames, <arguments>)``: the
 kernel call on one state, returning a status code (``layout``: -1
-success, ``OVERFLOW``, ``SINGULAR + j``, or the kernel's own).  One
-registration line below makes from it the single-state entry point
-``run_<term>`` (:func:`generate.entry`: every size checked against the
-model, since numba does not check bounds, and every input for
-finiteness: ``SIZE + a``, ``NONFINITE * a + i``) and, where the term has
-one, the batch loop ``run_<term>_batch`` (:func:`generate.batch`: the
-row step on each row of (m, n) arrays; the caller checks shapes and
-finiteness in numpy, once per batch; it returns -1, or the first row
-that failed with its code in ``status[0]``).  The entry points take the
-model packed into one array (``layout.pack``) and the switches as one
-integer (``layout.flags``): few arguments, because numba's dispatcher
-costs about 40 ns per argument.  They are compiled with ``_jit.ENTRY``
-(no reference-counting runtime: see there).  ``generate.SOURCES`` holds
-the text of each.
+success, ``OVERFLOW``, ``SINGULAR + j``, or the kernel's own).  One line
+of :data:`ENTRIES` at the end of this file names an entry point and its
+row step; ``generate.py`` writes from them ``entries.py``, a checked-in
+file: the single-state entry point ``run_<term>`` (every size checked
+against the model, since numba does not check bounds, and every input
+for finiteness: ``SIZE + a``, ``NONFINITE * a + i``) and, for a name
+ending in ``_batch``, the batch loop (the row step on each row of (m, n)
+arrays; the caller checks shapes and finiteness in numpy, once per
+batch; it returns -1, or the first row that failed with its code in
+``status[0]``).  The entry points take the model packed into one array
+(``layout.pack``) and the switches as one integer (``layout.flags``):
+few arguments, because numba's dispatcher costs about 40 ns per
+argument.  They are compiled with ``_jit.ENTRY`` (no reference-counting
+runtime: see there).
 
 Adding a term: its kernel in the file of its pass; its row step here;
-and its registration lines at the end of this file
-(``run_<term> = entry(<term>_row)``, ``run_<term>_batch =
-batch(<term>_row)``).  The row step's argument names say what each is
-(``generate.SHAPES``: a new kind of array gets a line there).  Then its
-strict entry and public function in ``core/dynamics.py``, its batch
-function in ``core/batch.py``.
+its lines in :data:`ENTRIES`; then ``python -m
+newton_euler_ros.core.kernels.generate --write`` (``test_entry_points``
+fails until ``entries.py`` is regenerated).  The row step's argument
+names say what each is (``generate.SHAPES``: a new kind of array gets a
+line there).  Then its strict entry and public function in
+``core/dynamics.py``, its batch function in ``core/batch.py``.
 """
 from ._jit import njit
 from .aba import articulated_body
 from .coriolis import coriolis_matrix_composite
 from .crba import mass_matrix_crba
 from .derivatives import aba_derivatives, rnea_derivatives
-from .generate import batch, entry
 from .kinematics import forward_kinematics, jacobian, joint_trig
-from .layout import (A_WIDTH, CW_WIDTH, DW_WIDTH, F_ROWS, F_TREE,  # noqa
-                     GRAVITY, LINK_WRENCHES, NONFINITE, OVERFLOW, SINGULAR, SIZE,
-                     T_NQ, VELOCITY, W_WIDTH, WRENCH_BITS, WRENCH_SHIFT)
+from .layout import (F_ROWS, F_TREE, GRAVITY, LINK_WRENCHES, OVERFLOW,
+                     SINGULAR, T_NQ, VELOCITY, WRENCH_BITS, WRENCH_SHIFT)
 from .newton_euler import (coriolis_matrix_columns, gravity,
                            mass_matrix_columns, momentum_terms, recursion)
 from .regressor import drive_columns, regressor_columns
-from .status import (first_nonfinite, first_nonfinite_entry,  # noqa: F401
-                     matrix_status)
-
-# A_WIDTH, CW_WIDTH, DW_WIDTH, NONFINITE, SIZE and W_WIDTH are read by the generated
-# checks (generate.SHAPES), from this module's globals.
+from .status import first_nonfinite, matrix_status
 
 
 @njit(cache=True)
@@ -251,33 +245,37 @@ def forward_dynamics_derivatives_links_row(links, frames, q, qd, tau, wrench,
 
 
 # ---------------------------------------------------------------------------
-# the registrations: one entry point (and batch loop) per row step
+# the entry points: name and row step.  generate.py writes each into
+# entries.py (``python -m newton_euler_ros.core.kernels.generate
+# --write``): a name ending in _batch gets the batch loop, any other the
+# single-state entry point.
 
-run_inverse_dynamics = entry(inverse_dynamics_row)
-run_inverse_dynamics_batch = batch(inverse_dynamics_row)
-run_inverse_dynamics_links = entry(inverse_dynamics_links_row)
-run_gravity_torques = entry(gravity_torques_row)
-run_gravity_torques_batch = batch(gravity_torques_row)
-run_mass_matrix_crba = entry(mass_matrix_crba_row)
-run_mass_matrix_batch = batch(mass_matrix_crba_row, 'run_mass_matrix_batch')
-run_mass_matrix = entry(mass_matrix_row)
-run_coriolis_matrix = entry(coriolis_matrix_row)
-run_coriolis_matrix_batch = batch(coriolis_matrix_composite_row,
-                                  'run_coriolis_matrix_batch')
-run_momentum_terms = entry(momentum_terms_row)
-run_forward_dynamics = entry(forward_dynamics_row)
-run_forward_dynamics_batch = batch(forward_dynamics_row)
-run_forward_dynamics_links = entry(forward_dynamics_links_row)
-run_jacobian = entry(jacobian_row)
-run_link_poses = entry(link_poses_row)
-run_regressor_batch = batch(regressor_row)
-run_inverse_dynamics_derivatives = entry(inverse_dynamics_derivatives_row)
-run_inverse_dynamics_derivatives_batch = batch(
-    inverse_dynamics_derivatives_row)
-run_inverse_dynamics_derivatives_links = entry(
-    inverse_dynamics_derivatives_links_row)
-run_forward_dynamics_derivatives = entry(forward_dynamics_derivatives_row)
-run_forward_dynamics_derivatives_batch = batch(
-    forward_dynamics_derivatives_row)
-run_forward_dynamics_derivatives_links = entry(
-    forward_dynamics_derivatives_links_row)
+ENTRIES = (
+    ('run_inverse_dynamics', inverse_dynamics_row),
+    ('run_inverse_dynamics_batch', inverse_dynamics_row),
+    ('run_inverse_dynamics_links', inverse_dynamics_links_row),
+    ('run_gravity_torques', gravity_torques_row),
+    ('run_gravity_torques_batch', gravity_torques_row),
+    ('run_mass_matrix_crba', mass_matrix_crba_row),
+    ('run_mass_matrix_batch', mass_matrix_crba_row),
+    ('run_mass_matrix', mass_matrix_row),
+    ('run_coriolis_matrix', coriolis_matrix_row),
+    ('run_coriolis_matrix_batch', coriolis_matrix_composite_row),
+    ('run_momentum_terms', momentum_terms_row),
+    ('run_forward_dynamics', forward_dynamics_row),
+    ('run_forward_dynamics_batch', forward_dynamics_row),
+    ('run_forward_dynamics_links', forward_dynamics_links_row),
+    ('run_jacobian', jacobian_row),
+    ('run_link_poses', link_poses_row),
+    ('run_regressor_batch', regressor_row),
+    ('run_inverse_dynamics_derivatives', inverse_dynamics_derivatives_row),
+    ('run_inverse_dynamics_derivatives_batch',
+     inverse_dynamics_derivatives_row),
+    ('run_inverse_dynamics_derivatives_links',
+     inverse_dynamics_derivatives_links_row),
+    ('run_forward_dynamics_derivatives', forward_dynamics_derivatives_row),
+    ('run_forward_dynamics_derivatives_batch',
+     forward_dynamics_derivatives_row),
+    ('run_forward_dynamics_derivatives_links',
+     forward_dynamics_derivatives_links_row),
+)
