@@ -108,6 +108,10 @@ if [[ "${SETUP_FORCE:-0}" != 1 && -x "$VENV/bin/python" ]] \
    && stamp_ok venv "$H_VENV" && stamp_ok interfaces "$H_IFACE" \
    && stamp_ok package "$H_PKG" && stamp_ok tools "$H_TOOLS"; then
   log "up to date (.venv; remove it or run 'make clean' to start over)"
+  # the kernels' sources may have changed since (an edit, a pull): their
+  # compiled cache is stamped by their digest, a no-op when it matches
+  "$VENV/bin/python" -m newton_euler_ros.precompile \
+    || die "compiling the kernels ahead (python -m newton_euler_ros.precompile) failed"
   exit 0
 fi
 

@@ -34,8 +34,10 @@ constants: the compiled code is what hand-numbered columns gave.
 ``test_layout.py`` checks that every ``L_*`` (and the others) is declared
 and that every constant offset the kernels add stays inside its field.
 
-Everything here is importable from :mod:`newton_euler_ros.core.kernels`
-(``from newton_euler_ros.core.kernels import L_MASS, F_GRAV``).
+The package :mod:`newton_euler_ros.core.kernels` re-exports the names
+its callers use (``from newton_euler_ros.core.kernels import L_MASS,
+F_GRAV``); ``W_R0`` and the derivative workspaces' ``DW_*`` and
+``DS_*`` fields, which only the kernels read, are imported from here.
 """
 
 
