@@ -281,21 +281,19 @@ def read_drives(root, joint_names, label='robot_description', prior=False,
                 if v is not None:
                     vals[attr][j] = v
                     found = True
-            v = _number(ext, 'coulomb_width', where, label)
-            if v is not None:
-                if not v > 0:
-                    raise RobotFileError(
-                        f'{label}: {where} coulomb_width: must be > 0, got '
-                        f'{v:g}')
-                width[j] = v
-            v = _number(ext, 'torque_constant', where, label)
-            if v is not None:
-                if not v > 0:
-                    raise RobotFileError(
-                        f'{label}: {where} torque_constant: must be > 0 (N m '
-                        f'per effort unit), got {v:g}')
-                constant[j] = v
-                found = True
+            # positive attributes; the width alone does not make a drive
+            for attr, into, unit, makes in (
+                    ('coulomb_width', width, '', False),
+                    ('torque_constant', constant, ' (N m per effort unit)',
+                     True)):
+                v = _number(ext, attr, where, label)
+                if v is not None:
+                    if not v > 0:
+                        raise RobotFileError(
+                            f'{label}: {where} {attr}: must be > 0{unit}, '
+                            f'got {v:g}')
+                    into[j] = v
+                    found = found or makes
     if not found:
         return None
     return Drives(vals['viscous'], vals['coulomb'], vals['offset'],

@@ -139,6 +139,19 @@ class Float32Dynamics:
         K.round_into(_vector(names[arg], x, size), buf)
         return buf
 
+    def _finite_square(self, q, q32, qd, qd32, out):
+        """
+        Check q and qd finite in float32; return D's or C's array.
+
+        That array is ``out``, checked, or a new (n, n) float32 one.
+        """
+        zeros = self._zeros
+        bad = K.check_finite(q32, qd32, zeros, self._zero_wrench)
+        if bad >= 0:
+            _raise(bad, (q32, qd32, zeros, zeros), (q, qd, None, None))
+        n = self.n
+        return np.empty((n, n), dtype=_F32) if out is None else _out(out)
+
     # ------------------------------------------------------------------
     # dynamics
 
@@ -175,13 +188,8 @@ class Float32Dynamics:
         default) or ``'newton_euler'`` (n recursions), as in
         :func:`~newton_euler_ros.core.dynamics.mass_matrix`.
         """
-        n = self.n
-        q32 = self._vec(0, q, n)
-        zeros = self._zeros
-        bad = K.check_finite(q32, zeros, zeros, self._zero_wrench)
-        if bad >= 0:
-            _raise(bad, (q32, zeros, zeros, zeros), (q, None, None, None))
-        D = np.empty((n, n), dtype=_F32) if out is None else _out(out)
+        q32 = self._vec(0, q, self.n)
+        D = self._finite_square(q, q32, None, self._zeros, out)
         if method not in ('newton_euler', 'crba'):
             raise _bad_method(method)
         if K.run_mass_matrix(self.packed, q32, method == 'crba', self._ws.ws,
@@ -202,11 +210,7 @@ class Float32Dynamics:
             raise _bad_method(method, CORIOLIS_METHODS)
         q32 = self._vec(0, q, n)
         qd32 = self._vec(1, qd, n)
-        zeros = self._zeros
-        bad = K.check_finite(q32, qd32, zeros, self._zero_wrench)
-        if bad >= 0:
-            _raise(bad, (q32, qd32, zeros, zeros), (q, qd, None, None))
-        C = np.empty((n, n), dtype=_F32) if out is None else _out(out)
+        C = self._finite_square(q, q32, qd, qd32, out)
         if K.run_coriolis_matrix(self.packed, q32, qd32, method == 'composite',
                                  self._ws.ws, self._ws.cw, self._ws.scratch,
                                  C) >= 0:
