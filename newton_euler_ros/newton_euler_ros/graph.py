@@ -26,24 +26,30 @@ their remappable topics.
 SIM = '/robot_sim_node'
 ID = '/inverse_dynamics_node'
 
+
+def controller_remaps(sim, commands):
+    """
+    (from, to) remaps of tracking_controller_node closing a loop.
+
+    ``sim`` is the plant node's name (its ``start`` service), ``commands``
+    the topic that takes the controller's torques.
+    """
+    return (
+        ('~/start', f'{sim}/start'),
+        ('~/feedforward', f'{ID}/torques'),
+        ('~/reference', f'{ID}/reference'),
+        ('~/commands', commands),
+    )
+
+
 #: (from, to) remaps of tracking_controller_node in the closed loop
-CONTROLLER_REMAPS = (
-    ('~/start', f'{SIM}/start'),
-    ('~/feedforward', f'{ID}/torques'),
-    ('~/reference', f'{ID}/reference'),
-    ('~/commands', f'{SIM}/commands'),
-)
+CONTROLLER_REMAPS = controller_remaps(SIM, f'{SIM}/commands')
 
 # the same loop with MuJoCo as the plant (mujoco_sim_node), which takes
 # efforts where ros2_control's effort forward controller does
 MUJOCO_SIM = '/mujoco_sim_node'
 EFFORT_COMMANDS = '/effort_controller/commands'
-MUJOCO_CONTROLLER_REMAPS = (
-    ('~/start', f'{MUJOCO_SIM}/start'),
-    ('~/feedforward', f'{ID}/torques'),
-    ('~/reference', f'{ID}/reference'),
-    ('~/commands', EFFORT_COMMANDS),
-)
+MUJOCO_CONTROLLER_REMAPS = controller_remaps(MUJOCO_SIM, EFFORT_COMMANDS)
 
 
 #: (name in the node, launch argument, default, description) of the topics
