@@ -420,55 +420,49 @@ class InverseDynamicsNode(SharedGraphNode):
             f'{self.counts["over_limit"]} over so far; said again when '
             f'other joints go over)')
 
-    def _on_wrench(self, msg):
-        w = msg.wrench
+    def _take(self, source, use, msg):
+        """
+        Return ``use(ff, msg)`` with the current model.
+
+        None where there is no model yet or ``use`` raises: the message is
+        then dropped and counted as ``source``'s (InputRejected, or
+        anything else, which must never kill the node).
+        """
         ff = self.ff
         if ff is None:
-            self._no_model('wrench')
-            return
+            self._no_model(source)
+            return None
         try:
-            ff.wrench.update(
-                msg.header.frame_id,
-                (w.force.x, w.force.y, w.force.z,
-                 w.torque.x, w.torque.y, w.torque.z),
-                seconds(msg.header.stamp), self._now())
-        except InputRejected as exc:
-            self._reject('wrench', exc)
+            return use(ff, msg)
         except Exception as exc:
-            self._reject('wrench', exc)
+            self._reject(source, exc)
+            return None
+
+    def _on_wrench(self, msg):
+        self._take('wrench', self._use_wrench, msg)
+
+    def _use_wrench(self, ff, msg):
+        w = msg.wrench
+        ff.wrench.update(
+            msg.header.frame_id,
+            (w.force.x, w.force.y, w.force.z,
+             w.torque.x, w.torque.y, w.torque.z),
+            seconds(msg.header.stamp), self._now())
 
     def _on_reference(self, msg):
-        ff = self.ff
-        if ff is None:
-            self._no_model('reference')
-            return
-        try:
-            points = [(seconds(pt.time_from_start), pt.accelerations)
-                      for pt in msg.points]
-            ff.reference.set(msg.joint_names, seconds(msg.header.stamp),
-                             points, self._now())
-        except InputRejected as exc:
-            self._reject('reference', exc)
-        except Exception as exc:
-            self._reject('reference', exc)
+        self._take('reference', self._use_reference, msg)
+
+    def _use_reference(self, ff, msg):
+        points = [(seconds(pt.time_from_start), pt.accelerations)
+                  for pt in msg.points]
+        ff.reference.set(msg.joint_names, seconds(msg.header.stamp),
+                         points, self._now())
 
     def _on_trajectory(self, msg):
-        ff = self.ff
-        if ff is None:
-            self._no_model('trajectory')
+        got = self._take('trajectory', self._trajectory_efforts, msg)
+        if got is None:
             return
-        try:
-            points = [{'time_from_start': seconds(pt.time_from_start),
-                       'positions': pt.positions,
-                       'velocities': pt.velocities,
-                       'accelerations': pt.accelerations}
-                      for pt in msg.points]
-            efforts, exceeded = ff.trajectory(
-                msg.joint_names, points, self._now(),
-                self.params['trajectory.include_wrench'])
-        except Exception as exc:  # InputRejected, or never let it kill
-            self._reject('trajectory', exc)
-            return
+        ff, efforts, exceeded = got
         if exceeded:
             self._over_limit(ff, 'trajectory effort', exceeded)
         if efforts is None:
@@ -477,6 +471,18 @@ class InverseDynamicsNode(SharedGraphNode):
             pt.effort = effort.tolist()
         self.traj_pub.publish(msg)
         self.counts['trajectories'] += 1
+
+    def _trajectory_efforts(self, ff, msg):
+        """Return ``ff`` and its efforts along ``msg`` and those exceeded."""
+        points = [{'time_from_start': seconds(pt.time_from_start),
+                   'positions': pt.positions,
+                   'velocities': pt.velocities,
+                   'accelerations': pt.accelerations}
+                  for pt in msg.points]
+        efforts, exceeded = ff.trajectory(
+            msg.joint_names, points, self._now(),
+            self.params['trajectory.include_wrench'])
+        return ff, efforts, exceeded
 
     def _on_compute_dynamics(self, request, response):
         return self._serve(answer, request, response)
