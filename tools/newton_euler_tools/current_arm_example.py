@@ -439,7 +439,7 @@ def make_example(out_dir, seed=0, effort='current', seconds=60.0,
 
 def main(argv=None):
     """Write the example files."""
-    from .ident_example import example_parser
+    from .ident_example import example_parser, print_paths
     parser = example_parser(__doc__)
     parser.add_argument('--seed', type=int, default=0)
     parser.add_argument('--effort', choices=('current', 'torque'),
@@ -460,9 +460,7 @@ def main(argv=None):
                          seconds=args.seconds, free=args.free,
                          pushes=args.pushes, rate=args.rate,
                          unmodelled=args.unmodelled)
-    for key, value in paths.items():
-        print(f'{key}: {value}')
-    return 0
+    return print_paths(paths)
 
 
 if __name__ == '__main__':

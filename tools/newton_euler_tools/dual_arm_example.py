@@ -415,21 +415,15 @@ def make_example(out_dir, seed=0, seconds=60.0, rate=100.0,
 
 def main(argv=None):
     """Write the example files."""
-    from .ident_example import example_parser
-    parser = example_parser(__doc__)
-    parser.add_argument('--seed', type=int, default=0)
-    parser.add_argument('--seconds', type=float, default=60.0)
-    parser.add_argument('--rate', type=float, default=100.0)
+    from .ident_example import example_parser, print_paths
+    parser = example_parser(__doc__, seconds=60.0, rate=100.0)
     parser.add_argument('--effort', choices=('torque', 'current'),
                         default='torque')
     parser.add_argument('--robot', choices=sorted(ROBOTS), default='baxter')
     args = parser.parse_args(argv)
     paths = make_example(args.out_dir, args.seed, args.seconds, args.rate,
                          args.effort, robot=args.robot)
-    for key, value in paths.items():
-        if key != 'truth':
-            print(f'{key}: {value}')
-    return 0
+    return print_paths(paths, leave_out=('truth',))
 
 
 if __name__ == '__main__':

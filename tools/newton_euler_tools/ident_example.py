@@ -282,27 +282,40 @@ def write_truth(out_dir, truth):
     return path
 
 
-def example_parser(doc):
-    """Return an example writer's parser: ``doc``'s first line, ``out_dir``."""
+def example_parser(doc, seconds=None, rate=None):
+    """
+    Return an example writer's parser: ``doc``'s first line, ``out_dir``.
+
+    With ``seconds`` and ``rate``, also the options of a recording:
+    ``--seed`` (default 0), ``--seconds`` and ``--rate`` with these
+    defaults.
+    """
     parser = argparse.ArgumentParser(description=doc.strip().split('\n')[0])
     parser.add_argument('out_dir')
+    if seconds is not None:
+        parser.add_argument('--seed', type=int, default=0)
+        parser.add_argument('--seconds', type=float, default=seconds)
+        parser.add_argument('--rate', type=float, default=rate)
     return parser
+
+
+def print_paths(paths, leave_out=()):
+    """Print ``name: path`` for each file an example wrote; return 0."""
+    for key, value in paths.items():
+        if key not in leave_out:
+            print(f'{key}: {value}')
+    return 0
 
 
 def main(argv=None):
     """Write the example files."""
-    parser = example_parser(__doc__)
-    parser.add_argument('--seconds', type=float, default=40.0)
-    parser.add_argument('--rate', type=float, default=500.0)
-    parser.add_argument('--seed', type=int, default=0)
+    parser = example_parser(__doc__, seconds=40.0, rate=500.0)
     parser.add_argument('--storage', choices=('mcap', 'sqlite3'),
                         default='mcap')
     args = parser.parse_args(argv)
     paths = make_example(args.out_dir, args.seconds, args.rate, args.seed,
                          args.storage)
-    for key in ('urdf', 'recording', 'validation'):
-        print(f'{key}: {paths[key]}')
-    return 0
+    return print_paths(paths, leave_out=('truth',))
 
 
 if __name__ == '__main__':

@@ -29,7 +29,6 @@ Writes into OUT_DIR:
     python -m newton_euler_tools.payload_example OUT_DIR [--mass KG]
            [--com X Y Z] [--seconds S] [--seed N] [--only-base]
 """
-import json
 import os
 import shutil
 import warnings
@@ -38,7 +37,8 @@ import numpy as np
 
 from .ident_example import (BASE, example_parser, EXTRA,
                             fourier_trajectory, measured_efforts,
-                            panda_path, random_drives, TIP)
+                            panda_path, print_paths, random_drives, TIP,
+                            write_truth)
 
 MASS = 1.5
 COM = (0.01, -0.02, 0.06)
@@ -124,10 +124,7 @@ def make_example(out_dir, mass=MASS, com=COM, inertia_c=INERTIA_C,
              'payload.inertia': [float(Ic[a, b]) for a, b in
                                  ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2),
                                   (0, 2))]}
-    path = os.path.join(out_dir, 'truth.json')
-    with open(path, 'w', encoding='utf-8') as f:
-        json.dump(truth, f)
-    return {'urdf': arm, 'bag': bag, 'truth': path}
+    return {'urdf': arm, 'bag': bag, 'truth': write_truth(out_dir, truth)}
 
 
 def main(argv=None):
@@ -143,9 +140,7 @@ def main(argv=None):
     paths = make_example(args.out_dir, args.mass, args.com,
                          seconds=args.seconds, seed=args.seed,
                          only_base=args.only_base)
-    for k, v in paths.items():
-        print(f'{k}: {v}')
-    return 0
+    return print_paths(paths)
 
 
 if __name__ == '__main__':
