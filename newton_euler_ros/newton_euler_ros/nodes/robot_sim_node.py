@@ -115,20 +115,32 @@ def publish_wrench(pub, msg, stamp, w):
     pub.publish(msg)
 
 
+def declare_scene_parameters(node, name):
+    """
+    Declare the parameters of node ``name`` on ``node``; load its scene.
+
+    Sets ``node.specs`` and ``node.scene`` and returns the parameters'
+    values; a scene that does not load is a ConfigurationError naming
+    ``scene`` (robot_sim_node and tracking_controller_node).
+    """
+    node.specs = load_specs(name)
+    p = declare_parameters(node, node.specs)
+    try:
+        node.scene = load_scene(p['scene'])
+    except NewtonEulerError as exc:
+        raise ConfigurationError(f'scene: {exc}') from None
+    return p
+
+
 class RobotSimNode(SharedGraphNode):
     """Simulate a scene; torques in on ~/commands, joint states out."""
 
     def __init__(self, **kwargs):
         super().__init__('robot_sim_node', **kwargs)
-        self.specs = load_specs('robot_sim_node')
-        p = declare_parameters(self, self.specs)
+        p = declare_scene_parameters(self, 'robot_sim_node')
         self.wait = p['wait_for_controller']
         self.subscribers = p['wait_for_subscribers']
         rtf = p['real_time_factor']
-        try:
-            self.scene = load_scene(p['scene'])
-        except NewtonEulerError as exc:
-            raise ConfigurationError(f'scene: {exc}') from None
         scene = self.scene
         self.payload = tuple(p[k] for k in PAYLOAD)
         try:

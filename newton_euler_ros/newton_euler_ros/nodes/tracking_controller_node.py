@@ -54,11 +54,8 @@ from sensor_msgs.msg import JointState
 from std_msgs.msg import Float64MultiArray, Header
 from trajectory_msgs.msg import JointTrajectory, JointTrajectoryPoint
 
-from .common import (ConfigurationError, declare_parameters, qos_profile,
-                     run_node, seconds, SharedGraphNode)
-from ..core import NewtonEulerError
-from ..parameters import load_specs
-from ..sim.scene import load_scene
+from .common import qos_profile, run_node, seconds, SharedGraphNode
+from .robot_sim_node import declare_scene_parameters
 from ..sim.simulate import pd_torque
 
 SAMPLE = 0.01           # reference sampling period, seconds
@@ -102,15 +99,10 @@ class TrackingControllerNode(SharedGraphNode):
 
     def __init__(self, **kwargs):
         super().__init__('tracking_controller_node', **kwargs)
-        self.specs = load_specs('tracking_controller_node')
-        p = declare_parameters(self, self.specs)
+        p = declare_scene_parameters(self, 'tracking_controller_node')
         self.use_ff = p['feedforward']
         self.wait_subscribers = p['wait_for_subscribers']
         self.qos = qos_profile(10, 'reliable')
-        try:
-            self.scene = load_scene(p['scene'])
-        except NewtonEulerError as exc:
-            raise ConfigurationError(f'scene: {exc}') from None
         self.names = list(self.scene.model.joint_names)
         self.n = len(self.names)
         self.t0 = None
