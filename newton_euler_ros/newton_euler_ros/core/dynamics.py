@@ -178,12 +178,24 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
                 w.zero_wrench if wrench is None else wrench, flags, w.ws,
                 tau) < 0:
             return tau
-    except Refused:
-        pass
-    except AttributeError:
-        foreign_workspace(model, ws)    # raises for a ws of another type
-        raise
+    except (Refused, AttributeError) as exc:
+        _fast_call_failed(exc, model, ws)
     return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
+
+
+def _fast_call_failed(exc, model, ws):
+    """
+    Settle what a fast entry raised: return, or raise the right error.
+
+    Refused (an argument of another type or size) returns: the caller
+    converts its arguments and calls again, for the error that names
+    them.  An AttributeError is a ``ws`` that is not a Workspace (its
+    one-line error), or else a bug, raised as it is.  Only the failing
+    call comes here: the fast path costs no call more.
+    """
+    if not isinstance(exc, Refused):
+        foreign_workspace(model, ws)
+        raise exc
 
 
 def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
@@ -245,11 +257,8 @@ def gravity_torques(model, q, *, ws=None, out=None):
         tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
-    except Refused:
-        pass
-    except AttributeError:
-        foreign_workspace(model, ws)    # raises for a ws of another type
-        raise
+    except (Refused, AttributeError) as exc:
+        _fast_call_failed(exc, model, ws)
     return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
 
 
@@ -277,11 +286,8 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
             D = np.empty((w.n, w.n)) if out is None else out
             if _crba(model.packed, q, w.ws, D) < 0:
                 return D
-        except Refused:
-            pass
-        except AttributeError:
-            foreign_workspace(model, ws)
-            raise
+        except (Refused, AttributeError) as exc:
+            _fast_call_failed(exc, model, ws)
     elif method != 'newton_euler':
         raise bad_method(method)
     ws = workspace(model, ws)
@@ -334,11 +340,8 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
         if _coriolis(model.packed, q, qd, composite, w.ws, w.cw, w.scratch,
                      C) < 0:
             return C
-    except Refused:
-        pass
-    except AttributeError:
-        foreign_workspace(model, ws)    # raises for a ws of another type
-        raise
+    except (Refused, AttributeError) as exc:
+        _fast_call_failed(exc, model, ws)
     ws = workspace(model, ws)
     n = ws.n
     q, qd = vector('q', q, n), vector('qd', qd, n)
@@ -391,11 +394,8 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                     w.zero_wrench if wrench is None else wrench, flags,
                     w.ws, w.aw, qdd) < 0:
                 return qdd
-        except Refused:
-            pass
-        except AttributeError:
-            foreign_workspace(model, ws)
-            raise
+        except (Refused, AttributeError) as exc:
+            _fast_call_failed(exc, model, ws)
         return _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame,
                               flags, out)
     if method != 'cholesky':
