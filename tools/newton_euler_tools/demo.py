@@ -234,6 +234,52 @@ def wait_for(recorder, children, predicate, what):
     poll(predicate, what, check, lambda: recorder.spin_once(0.05))
 
 
+def start_controller(recorder, children, label, domain, log_dir, duration,
+                     *, scene, feedforward, tail):
+    """
+    Start tracking_controller_node, the last node; wait for t = 0.
+
+    It waits for two subscribers (the plant and ``recorder``) and takes
+    ``scene``, ``feedforward`` ('true' or 'false') and then the arguments
+    ``tail`` (clock, remaps); it is added to ``children`` and returned
+    once the recorder has the plant's start time.
+    """
+    controller = Child(
+        f'{label}_tracking_controller_node',
+        'newton_euler_ros.nodes.tracking_controller_node',
+        ['-p', f'scene:={scene}', '-p', f'feedforward:={feedforward}',
+         '-p', 'wait_for_subscribers:=2', *tail], domain, log_dir)
+    children.append(controller)
+    wait_for(recorder, children, lambda: recorder.t0 is not None,
+             'the simulation start')
+    print(f'[{label}] nodes up in domain {domain}; simulating '
+          f'{duration:g} s', flush=True)
+    return controller
+
+
+def run_to(recorder, children, duration, timeout, late, tick=None):
+    """
+    Spin until the recorder's last state is at t = ``duration``.
+
+    Checks the children alive on every pass, calls ``tick(t)`` with each
+    new last time, and raises DemoError(``late``) after ``timeout``
+    seconds of wall clock.
+    """
+    end = time.monotonic() + timeout
+    while True:
+        recorder.spin_once()
+        for child in children:
+            child.check_alive()
+        t = recorder.last_time()
+        if t is not None:
+            if tick is not None:
+                tick(t)
+            if t >= duration - 1e-9:
+                return
+        if time.monotonic() > end:
+            raise DemoError(late)
+
+
 COUNT = re.compile(r'commands (sent|received): (\d+)')
 
 
@@ -283,36 +329,21 @@ def run_graph(scene_arg, label, feedforward, duration, domain, log_dir,
                  lambda: recorder.publishers(f'{ID}/torques') >= 1
                  and recorder.subscribers(commands) >= 1,
                  f'{node} and inverse_dynamics_node')
-        controller = Child(
-            f'{label}_tracking_controller_node',
-            'newton_euler_ros.nodes.tracking_controller_node',
-            ['-p', f'scene:={scene_arg}', '-p', f'feedforward:={ff}',
-             # the simulator and this recorder
-             '-p', 'wait_for_subscribers:=2', *sim_time,
-             *ros_args(remaps)], domain, log_dir)
-        children.append(controller)
-        wait_for(recorder, children, lambda: recorder.t0 is not None,
-                 'the simulation start')
-        print(f'[{label}] nodes up in domain {domain}; simulating '
-              f'{duration:g} s', flush=True)
-        next_report = 1.0
-        end = time.monotonic() + STARTUP_TIMEOUT + 10.0 * duration
-        while True:
-            recorder.spin_once()
-            for child in children:
-                child.check_alive()
-            t = recorder.last_time()
-            if t is not None:
-                while t >= next_report - 1e-9 and next_report <= duration:
-                    print(f'[{label}] t = {next_report:4.1f} s simulated, '
-                          f'{len(recorder.states)} joint states, '
-                          f'{len(recorder.commands)} commands', flush=True)
-                    next_report += 1.0
-                if t >= duration - 1e-9:
-                    break
-            if time.monotonic() > end:
-                raise DemoError(f'[{label}] simulation did not reach '
-                                f't = {duration} s in time')
+        controller = start_controller(
+            recorder, children, label, domain, log_dir, duration,
+            scene=scene_arg, feedforward=ff,
+            tail=[*sim_time, *ros_args(remaps)])
+        next_report = [1.0]
+
+        def report(t):
+            while t >= next_report[0] - 1e-9 and next_report[0] <= duration:
+                print(f'[{label}] t = {next_report[0]:4.1f} s simulated, '
+                      f'{len(recorder.states)} joint states, '
+                      f'{len(recorder.commands)} commands', flush=True)
+                next_report[0] += 1.0
+        run_to(recorder, children, duration, STARTUP_TIMEOUT + 10.0 * duration,
+               f'[{label}] simulation did not reach t = {duration} s in time',
+               report)
         # on a loaded machine the controller can lag the stream: give it
         # until as many commands as states up to t = duration are recorded
         # (the plant runs on meanwhile; with feedforward some states stay

@@ -43,8 +43,8 @@ import warnings
 from newton_euler_ros.graph import ID, SIM
 import numpy as np
 
-from .demo import (check_exits, Child, DemoError, Recorder, start_runs,
-                   STARTUP_TIMEOUT, stop_children, wait_for)
+from .demo import (check_exits, Child, DemoError, Recorder, run_to,
+                   start_runs, STARTUP_TIMEOUT, stop_children, wait_for)
 
 SCENE = 'puma_pick_and_place'
 # 3 kg held at the flange origin, the Puma's wrist centre: a load on the
@@ -209,16 +209,8 @@ def run(label, update_feedforward, duration, domain, log_dir, model, q0):
         # the object is in hand at t = PICK exactly, whatever the latency
         # of this call (a late pick would count as a feedforward error)
         rec.set_payload(SIM, dict(PAYLOAD, at=PICK))
-        end = time.monotonic() + 60.0 + 10.0 * duration
-        while True:
-            rec.spin_once()
-            for child in children:
-                child.check_alive()
-            t = rec.last_time()
-            if t is not None and t >= duration - 1e-9:
-                break
-            if time.monotonic() > end:
-                raise DemoError(f'[{label}] did not reach t = {duration} s')
+        run_to(rec, children, duration, 60.0 + 10.0 * duration,
+               f'[{label}] did not reach t = {duration} s')
     finally:
         stop_children(children, rec, status)
     check_exits(label, status)

@@ -52,8 +52,8 @@ from newton_euler_ros.graph import (EFFORT_COMMANDS, ID,
                                     ros_args)
 import numpy as np
 
-from .demo import (check_exits, Child, DemoError, Recorder, start_runs,
-                   stop_children, wait_for)
+from .demo import (check_exits, Child, DemoError, Recorder, run_to,
+                   start_controller, start_runs, stop_children, wait_for)
 from .processes import first_domain
 
 SCENE = 'panda_mujoco_push'
@@ -174,28 +174,12 @@ def run_graph(scenes, sim, label, duration, domain, log_dir, thresholds):
                  and probe.subscribers(EFFORT_COMMANDS) >= 1
                  and probe.publishers(f'{ID}/contact') >= 1,
                  'mujoco_sim_node and inverse_dynamics_node')
-        controller = Child(
-            f'{label}_tracking_controller_node',
-            'newton_euler_ros.nodes.tracking_controller_node',
-            ['-p', f'scene:={id_scene}', '-p', 'feedforward:=true',
-             '-p', 'wait_for_subscribers:=2', *sim_time,
-             *ros_args(MUJOCO_CONTROLLER_REMAPS)], domain, log_dir)
-        children.append(controller)
-        wait_for(probe, children, lambda: probe.t0 is not None,
-                 'the simulation start')
-        print(f'[{label}] nodes up in domain {domain}; simulating '
-              f'{duration:g} s', flush=True)
-        end = time.monotonic() + STARTUP_TIMEOUT + 10.0 * duration
-        while True:
-            probe.spin_once()
-            for child in children:
-                child.check_alive()
-            t = probe.last_time()
-            if t is not None and t >= duration - 1e-9:
-                break
-            if time.monotonic() > end:
-                raise DemoError(f'[{label}] simulation did not reach '
-                                f't = {duration} s in time')
+        controller = start_controller(
+            probe, children, label, domain, log_dir, duration,
+            scene=id_scene, feedforward='true',
+            tail=[*sim_time, *ros_args(MUJOCO_CONTROLLER_REMAPS)])
+        run_to(probe, children, duration, STARTUP_TIMEOUT + 10.0 * duration,
+               f'[{label}] simulation did not reach t = {duration} s in time')
         # what is in flight: the node's outputs up to the last state
         last = int(round(probe.states[-1][0] * 1e6))
         until = time.monotonic() + 10.0
