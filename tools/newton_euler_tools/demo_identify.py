@@ -301,6 +301,16 @@ class PayloadSteps:
     ``last_seconds()`` and ``keep_told(run)`` are the plant's own.
     """
 
+    def __init__(self, args, out, base, started, count):
+        """Make ``out``'s logs folder; ``count`` domains from ``base``."""
+        self.args, self.out = args, out
+        self.log_dir = os.path.join(out, 'logs')
+        os.makedirs(self.log_dir, exist_ok=True)
+        self.steps = Steps(started)
+        self.domains = iter(range(base, base + count))
+        self.live = []
+        self.runs, self.truth = {}, {}
+
     def run(self):
         """All six steps; DemoError if one fails (every run stopped)."""
         try:
@@ -395,17 +405,10 @@ class Loop(PayloadSteps):
     """
 
     def __init__(self, args, out, base, started):
-        self.args, self.out = args, out
-        self.log_dir = os.path.join(out, 'logs')
-        os.makedirs(self.log_dir, exist_ok=True)
-        self.steps = Steps(started)
-        self.domains = iter(range(base, base + 4))
+        super().__init__(args, out, base, started, 4)
         self.period, self.periods, self.harmonics, self.budget = (
             QUICK if args.quick else FULL)
         self.duration = self.period * self.periods + 0.5
-        self.live = []
-        self.runs = {}
-        self.truth = {}
 
     def start_run(self, label, **kw):
         """Start a run's nodes in the next ROS domain."""

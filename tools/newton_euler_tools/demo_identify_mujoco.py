@@ -45,9 +45,8 @@ import os
 
 from .demo_identify import (ARMATURE, COULOMB, IDENTIFIED, KD, KP,
                             load_segment, newton_euler, PAYLOAD,
-                            PayloadSteps, PUBLISHED, START,
-                            Steps, TOLD, true_torques, UNTOLD, VISCOUS,
-                            warm_excite)
+                            PayloadSteps, PUBLISHED, START, TOLD,
+                            true_torques, UNTOLD, VISCOUS, warm_excite)
 from .demo_identify_report import payload_line
 from .demo_identify_runs import drive, LoopRun, wait_until
 from .ident_example import BASE, TIP
@@ -115,15 +114,10 @@ class MujocoLoop(PayloadSteps):
     """
 
     def __init__(self, args, out, base, started):
-        self.args, self.out = args, out
-        self.log_dir = os.path.join(out, 'logs')
-        os.makedirs(self.log_dir, exist_ok=True)
-        self.steps = Steps(started)
-        self.domains = iter(range(base, base + 5))
+        super().__init__(args, out, base, started, 5)
         self.excitations = QUICK if args.quick else FULL
         self.period, self.periods, self.harmonics = self.excitations[0][:3]
-        self.live = []
-        self.runs, self.segments, self.truth = {}, {}, {}
+        self.segments = {}
         self.noise = dict(NOISE, seed=args.seed)
 
     def start_run(self, label, scene, **kw):

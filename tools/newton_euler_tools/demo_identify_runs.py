@@ -216,15 +216,28 @@ class LoopRun:
                 '-p', f'payload.mass:={plant_payload["mass"]}',
                 '-p', f'payload.com:={_array(plant_payload["com"])}',
                 '-p', f'payload.inertia:={_array(plant_payload["inertia"])}']
+        self._start_nodes(
+            label, 'robot_sim_node', sim_args, urdf, compensate,
+            ['-r', f'~/trajectory_out:={SIM}/joint_trajectory'], domain,
+            log_dir)
+
+    def _start_nodes(self, label, plant, sim_args, urdf, compensate, remaps,
+                     domain, log_dir):
+        """
+        Start the plant node ``plant`` and inverse_dynamics_node.
+
+        The node gives the plan's gravity (and, with ``compensate``, the
+        drives') efforts, its robot from ``urdf`` or else from
+        robot_description, with the remaps ``remaps``.
+        """
         id_args = ['-p', f'base_link:={BASE}', '-p', f'tip_link:={TIP}',
                    '-p', 'mode:=gravity', '-p', 'drives.compensate:='
                    f'{"true" if compensate else "false"}',
-                   '-p', 'diagnostics_period:=0.2',
-                   '-r', f'~/trajectory_out:={SIM}/joint_trajectory']
+                   '-p', 'diagnostics_period:=0.2', *remaps]
         if urdf:
             id_args = ['-p', f'robot_file:={urdf}', *id_args]
-        self.children.append(Child(f'{label}_robot_sim_node',
-                                   'newton_euler_ros.nodes.robot_sim_node',
+        self.children.append(Child(f'{label}_{plant}',
+                                   f'newton_euler_ros.nodes.{plant}',
                                    sim_args, domain, log_dir))
         self.children.append(Child(
             f'{label}_inverse_dynamics_node',
@@ -245,24 +258,14 @@ class LoopRun:
                     '-p', 'lockstep:=true', '-p', 'real_time_factor:=0.0']
         for key, value in noise.items():
             sim_args += ['-p', f'noise.{key}:={value!r}']
-        id_args = ['-p', f'base_link:={BASE}', '-p', f'tip_link:={TIP}',
-                   '-p', 'mode:=gravity', '-p', 'drives.compensate:='
-                   f'{"true" if compensate else "false"}',
-                   '-p', 'diagnostics_period:=0.2',
-                   '-r', f'~/trajectory_out:={self.filled_topic}',
-                   '-r', f'joint_states:={CONTROLLER}/unused_joint_states']
-        if urdf:
-            id_args = ['-p', f'robot_file:={urdf}', *id_args]
+        self._start_nodes(
+            label, 'mujoco_sim_node', sim_args, urdf, compensate,
+            ['-r', f'~/trajectory_out:={self.filled_topic}',
+             '-r', f'joint_states:={CONTROLLER}/unused_joint_states'],
+            domain, log_dir)
         kp, kd = gains
         controller_args = ['-p', f'joints:={JOINTS!r}'.replace("'", '"'),
                            '-p', f'kp:={_array(kp)}', '-p', f'kd:={_array(kd)}']
-        self.children.append(Child(f'{label}_mujoco_sim_node',
-                                   'newton_euler_ros.nodes.mujoco_sim_node',
-                                   sim_args, domain, log_dir))
-        self.children.append(Child(
-            f'{label}_inverse_dynamics_node',
-            'newton_euler_ros.nodes.inverse_dynamics_node', id_args, domain,
-            log_dir))
         self.children.append(Child(
             f'{label}_trajectory_controller',
             'newton_euler_tools.trajectory_controller', controller_args,
