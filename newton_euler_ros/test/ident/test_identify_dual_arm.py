@@ -178,8 +178,11 @@ def test_the_payload_on_one_gripper(dual):
 
 
 def test_currents_with_a_known_mass_on_one_arm(tmp_path):
+    # 40 s recordings (not the example's 60): the constants come out
+    # within 0.1 % on the left and 1 % on the right either way
     paths = make_example(str(tmp_path), seed=1, effort='current',
-                         payload=False, validation_seconds=10.0)
+                         payload=False, validation_seconds=10.0,
+                         seconds=40.0)
     out = tmp_path / 'identified.urdf'
     common = (paths['urdf'], paths['excitation'], '--base', BASE, '-o', out)
     code, _, err = run('identify', *common)
