@@ -53,6 +53,7 @@ from .cli_export import register as register_export  # noqa: E402
 from .cli_identify import register as register_identify  # noqa: E402
 from .cli_loop import register as register_loop  # noqa: E402
 from .cli_observe import register as register_observe  # noqa: E402
+from .cli_options import chain_options, robot_argument  # noqa: E402
 from .cli_report import (format_table, mass_counted,  # noqa: E402
                          source, tree_lines, types_of)
 from .cli_ros import (register as register_ros, RosCliError,  # noqa: E402
@@ -373,13 +374,9 @@ def cmd_urdf(args):
 
 
 def _chain_options(parser):
-    parser.add_argument('--base', metavar='LINK',
-                        help='URDF only: first link of the chain (default: '
-                             'the root link)')
-    parser.add_argument('--tip', metavar='LINK',
-                        help='URDF only: last link of the chain, the end '
-                             'effector (default: none, the whole tree '
-                             'below the base)')
+    chain_options(parser, 'URDF only: last link of the chain, the end '
+                          'effector (default: none, the whole tree below '
+                          'the base)')
 
 
 def _wrench_options(parser, wrench_help, frame_help):
@@ -407,14 +404,11 @@ class _Parser(argparse.ArgumentParser):
         raise CliError(message)
 
 
-ROBOT_HELP = 'robot YAML or URDF file, or bundled robot name'
-
-
 def build_parser():
     parser = _Parser(prog='newton-euler', description=__doc__.strip().split('\n')[0])
     sub = parser.add_subparsers(dest='command', parser_class=_Parser)
     dyn = sub.add_parser('dynamics', help='tau, D, C, g and J at a state')
-    dyn.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    robot_argument(dyn)
     _chain_options(dyn)
     dyn.add_argument('--q', nargs='+', metavar='Q',
                      help='joint positions (rad or m)')
@@ -433,12 +427,12 @@ def build_parser():
                           ' and print a JSON list')
     dyn.set_defaults(func=cmd_dynamics)
     chk = sub.add_parser('check', help='validate a robot file')
-    chk.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    robot_argument(chk)
     _chain_options(chk)
     chk.set_defaults(func=cmd_check)
     urdf = sub.add_parser('urdf', help='write a robot as URDF (inertials, '
                                        'limits, a fixed tool0 link)')
-    urdf.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    robot_argument(urdf)
     urdf.add_argument('-o', '--output', metavar='FILE',
                       help='write to FILE instead of standard output')
     _chain_options(urdf)
@@ -459,7 +453,7 @@ def build_parser():
     sim.set_defaults(func=cmd_simulate)
     ff = sub.add_parser('feedforward', help='fill the effort of every point '
                                             'of a joint trajectory')
-    ff.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+    robot_argument(ff)
     ff.add_argument('trajectory', metavar='TRAJECTORY.json',
                     help='JSON: {"joint_names": [...], "points": '
                          '[{"time_from_start": t, "positions": [...], '

@@ -47,6 +47,8 @@ import time
 
 import numpy as np
 
+from .cli_options import recording_options
+
 EXIT_BAD_INPUT = 2
 
 
@@ -102,17 +104,10 @@ def register(subparsers):
 
 
 def _common(parser):
-    parser.add_argument('--base', metavar='LINK', required=True,
-                        help='first link of the chain, or the link the '
-                             'whole tree hangs from')
-    parser.add_argument('--tip', metavar='LINK',
-                        help='last link of the chain (default: the whole '
-                             'tree below --base)')
-    parser.add_argument('--topic', default='/joint_states',
-                        help='JointState topic (default /joint_states)')
-    parser.add_argument('--cutoff', type=float, metavar='HZ',
-                        help='low-pass cutoff (default min(10 Hz, a fifth '
-                             'of the sample rate))')
+    recording_options(parser, 'last link of the chain (default: the whole '
+                              'tree below --base)',
+                      'low-pass cutoff (default min(10 Hz, a fifth of the '
+                      'sample rate))')
 
 
 class _BadInput(Exception):

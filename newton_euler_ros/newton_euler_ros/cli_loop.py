@@ -42,6 +42,7 @@ import numpy as np
 # one line on stderr and exit status 2, as identify and replay
 from .cli_identify import (_describe, _fail, _load_urdf, _one_line_exit_2,
                            _payload_link)
+from .cli_options import recording_options
 
 
 def register(subparsers):
@@ -113,20 +114,14 @@ def register(subparsers):
     pay.add_argument('model', metavar='MODEL.urdf',
                      help='the arm without the payload (identified URDF)')
     pay.add_argument('bag', metavar='BAG', help='rosbag2 directory')
-    pay.add_argument('--base', metavar='LINK', required=True,
-                     help='first link of the chain, or the link the whole '
-                          'tree hangs from')
-    pay.add_argument('--tip', metavar='LINK',
-                     help='last link of the chain (default: the whole tree '
-                          'below --base); the payload is fixed to it unless '
-                          '--link says otherwise')
+    recording_options(pay, 'last link of the chain (default: the whole '
+                           'tree below --base); the payload is fixed to it '
+                           'unless --link says otherwise',
+                      'low-pass cutoff (default as identify)')
     pay.add_argument('--link', metavar='LINK',
                      help='the link the payload is fixed to; com and '
                           'inertia in its frame (default: the tip; needed '
                           'on a tree with several tips)')
-    pay.add_argument('--topic', default='/joint_states')
-    pay.add_argument('--cutoff', type=float, metavar='HZ',
-                     help='low-pass cutoff (default as identify)')
     pay.add_argument('--json', action='store_true',
                      help="print the node's payload.* parameters as JSON "
                           '(null where the motion does not determine a '

@@ -45,6 +45,8 @@ import tempfile
 
 import numpy as np
 
+from .cli_options import chain_options, robot_argument, topic_option
+
 WRENCH_COLUMNS = ('fx', 'fy', 'fz', 'mx', 'my', 'mz')
 
 
@@ -57,17 +59,12 @@ def register(subparsers):
     obs = subparsers.add_parser(
         'observe', help='run the momentum observer (external torque, '
                         'wrench, contact) over a recorded bag')
-    obs.add_argument('robot', metavar='ROBOT',
-                     help='URDF (or robot YAML) file, or bundled robot name')
+    robot_argument(obs)
     obs.add_argument('bag', metavar='BAG',
                      help='rosbag2 directory (MCAP or sqlite3) with '
                           'sensor_msgs/JointState')
-    obs.add_argument('--base', metavar='LINK',
-                     help='URDF only: first link of the chain (default: '
-                          'the root link)')
-    obs.add_argument('--tip', metavar='LINK',
-                     help='URDF only: last link, the end effector '
-                          '(default: the single leaf)')
+    chain_options(obs, 'URDF only: last link, the end effector (default: '
+                       'the single leaf)')
     obs.add_argument('--csv', metavar='OUT.csv',
                      help='write one row per sample here')
     obs.add_argument('--json', action='store_true',
@@ -76,8 +73,7 @@ def register(subparsers):
                           'order) instead of a table')
     obs.add_argument('--plot', metavar='OUT.png',
                      help='also plot external torques and wrench')
-    obs.add_argument('--topic', default='/joint_states',
-                     help='JointState topic (default /joint_states)')
+    topic_option(obs)
     obs.add_argument('--gain', type=float, default=50.0, metavar='K',
                      help='observer gain, 1/s (default 50)')
     obs.add_argument('--thresholds', type=float, nargs='+', default=[10.0],

@@ -57,6 +57,7 @@ import signal
 import sys
 import time
 
+from .cli_options import topic_option
 from .core.text import read_text
 
 MAX_TRAJECTORY_BYTES = 64 * 1024 * 1024
@@ -111,8 +112,7 @@ def register(subparsers):
         'record', help='record sensor_msgs/JointState to a rosbag2 (MCAP)')
     rec.add_argument('bag', metavar='BAG',
                      help='rosbag2 directory to create (must not exist)')
-    rec.add_argument('--topic', default='/joint_states',
-                     help='JointState topic (default: %(default)s)')
+    topic_option(rec)
     rec.add_argument('--duration', type=float, metavar='S',
                      help='stop after S seconds from the first message')
     rec.add_argument('--max-messages', type=int, metavar='N',
