@@ -40,6 +40,7 @@ from newton_euler_ros.core import (coriolis_matrix, Drives,
                                    Workspace)
 from newton_euler_ros.core.errors import (DynamicsInputError,
                                           NotPositiveDefiniteError)
+from newton_euler_ros.core.model import make_chain
 from newton_euler_ros.core.robot_file import RobotFileWarning
 import numpy as np
 import pytest
@@ -198,6 +199,46 @@ def test_identities(robot):
     dg, _ = inverse_dynamics_derivatives(model, q, np.zeros(n), np.zeros(n))
     assert rel(dg, dg.T) < 1e-13
     assert rel(dg, central(lambda x: gravity_torques(model, x), q)) < 1e-7
+
+
+def _two_arms(order):
+    """Two 3-joint arms on the base, numbered ``order`` (bodies a0..b2)."""
+    rng = np.random.default_rng(12)
+    names = ['a0', 'a1', 'a2', 'b0', 'b1', 'b2']
+    types = ['revolute', 'revolute', 'prismatic', 'revolute', 'prismatic',
+             'revolute']
+    posts = [[('xyz', *rng.uniform(-0.3, 0.3, 3)),
+              ('rpy', *rng.uniform(-1, 1, 3))] for _ in names]
+    axes = rng.normal(size=(6, 3))
+    masses = rng.uniform(0.5, 2.0, 6)
+    coms = rng.uniform(-0.1, 0.1, (6, 3))
+    inertias = [np.diag(rng.uniform(0.01, 0.02, 3)) for _ in names]
+    parent = {'a0': None, 'a1': 'a0', 'a2': 'a1', 'b0': None, 'b1': 'b0',
+              'b2': 'b1'}
+    k = [names.index(x) for x in order]
+    return make_chain(
+        'two_arms', order, [types[i] for i in k], [posts[i] for i in k],
+        axes[k], masses[k], coms[k], [inertias[i] for i in k],
+        parents=[-1 if parent[x] is None else order.index(parent[x])
+                 for x in order])
+
+
+def test_separate_roots_numbered_depth_first_or_not():
+    # depth first, the legs-and-torso case (D^-1 block diagonal, worked
+    # block by block), against the same robot numbered across its arms
+    # (the general loops)
+    first = _two_arms(['a0', 'a1', 'a2', 'b0', 'b1', 'b2'])
+    mixed = _two_arms(['a0', 'b0', 'a1', 'b1', 'a2', 'b2'])
+    k = [0, 3, 1, 4, 2, 5]     # mixed's coordinates in first's order
+    q, qd, qdd, tau = state(first, 13)
+    for model, x in ((first, slice(None)), (mixed, k)):
+        check_central(model, q[x], qd[x], qdd[x], tau[x])
+    want = forward_dynamics_derivatives(first, q, qd, tau)
+    got = forward_dynamics_derivatives(mixed, q[k], qd[k], tau[k])
+    back = np.argsort(k)
+    for a, b in zip(want, got):
+        assert rel(b[np.ix_(back, back)], a) < 1e-13
+        assert np.all(a[:3, 3:] == 0.0) and np.all(a[3:, :3] == 0.0)
 
 
 def test_batches_equal_single_calls():

@@ -252,6 +252,46 @@ def rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
 
 
 @njit(cache=True, inline='always')
+def depth_first(links):
+    """
+    Tell whether the bodies are numbered depth first (each subtree a run).
+
+    Each body's parent then lies on the path of the body numbered just
+    before it.  ``load_urdf`` numbers so; a model in another order
+    takes the general loops.  With it (and no mimic joints) D^-1 is
+    block diagonal, one block a root's run (Centauro's legs and torso
+    share no inertia), and the inverse dynamics' derivatives are zero
+    off each joint's path.
+    """
+    for i in range(1, links.shape[0]):
+        par = parent(links, i)
+        if par >= 0:
+            a = i - 1
+            while a >= 0 and a != par:
+                a = parent(links, a)
+            if a != par:
+                return False
+    return True
+
+
+@njit(cache=True, inline='always')
+def run_end(links, lo, n, blocks):
+    """
+    Return the end of the run of coordinates that starts at root ``lo``.
+
+    With ``blocks`` (``depth_first``) the next root's number, or n: where
+    the columns of D^-1 from lo on stop being nonzero; otherwise n (one
+    run, all coordinates).
+    """
+    if not blocks:
+        return n
+    hi = lo + 1
+    while hi < n and parent(links, hi) >= 0:
+        hi += 1
+    return hi
+
+
+@njit(cache=True, inline='always')
 def ltl_factor(links, H):
     """
     Factor H = L^T L in place, L lower triangular with the tree's sparsity.
@@ -293,13 +333,18 @@ def ltl_solve(links, L, x):
         while i >= 0:
             x[i] -= L[k, i] * y
             i = parent(links, i)
-    ltl_forward(links, L, x)
+    ltl_forward(links, L, x, 0, L.shape[0])
 
 
 @njit(cache=True, inline='always')
-def ltl_forward(links, L, x):
-    """Solve L x = y in place (x holds y), from the base."""
-    for k in range(L.shape[0]):
+def ltl_forward(links, L, x, lo, hi):
+    """
+    Solve L x = y in place (x holds y), from the base.
+
+    Only rows lo..hi-1: those of one root's run (``run_end``) when y is
+    zero outside it, all of them (0, n) otherwise.
+    """
+    for k in range(lo, hi):
         acc = x[k]
         i = parent(links, k)
         while i >= 0:
@@ -309,17 +354,18 @@ def ltl_forward(links, L, x):
 
 
 @njit(cache=True, inline='always')
-def ltl_inverse_column(links, frames, L, k, x):
+def ltl_inverse_column(links, frames, L, k, x, lo, hi):
     """
     Column k of (L^T L)^-1 into x, L from ``ltl_factor``.
 
     L^T y = e_k touches only k and its ancestors (walked up from k), then
-    L x = y from the base: O(depth^2 + n depth) rather than a full solve.
+    L x = y from the base, on rows lo..hi-1 only (k's run: ``run_end``;
+    the column is zero elsewhere): O(depth^2 + m depth) for a run of m
+    coordinates, rather than a full solve.
     """
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
-    n = L.shape[0]
-    for i in range(n):
+    for i in range(L.shape[0]):
         x[i] = zero
     x[k] = one
     m = k
@@ -331,29 +377,51 @@ def ltl_inverse_column(links, frames, L, k, x):
             x[i] -= L[m, i] * y
             i = parent(links, i)
         m = parent(links, m)
-    ltl_forward(links, L, x)
+    ltl_forward(links, L, x, lo, hi)
 
 
 @njit(cache=True, inline='always')
-def times_minus_inverse(frames, Minv, X, col):
+def subtract_row(Minv, m, x, col, lo, hi):
+    """col[lo:hi] -= x Minv[m, lo:hi]."""
+    for i in range(lo, hi):
+        col[i] -= Minv[m, i] * x
+
+
+@njit(cache=True, inline='always')
+def times_minus_inverse(links, frames, Minv, X, col, blocks):
     """
     X <- -Minv X in place, column by column (Minv symmetric).
 
-    Only X's nonzero entries cost: on a tree dtau/dq and dtau/dqd are
-    zero between joints on different branches.
+    With ``blocks`` (``depth_first``) column k of X is nonzero only on
+    k's path, its ancestors and its subtree (a run from k), and the
+    result only on the run of k's root, where Minv has its block: only
+    those cost.  Otherwise only X's nonzero entries cost.
     """
     zero = frames[F_CONST, C_ZERO]
     n = X.shape[0]
-    for k in range(n):
-        for i in range(n):
-            col[i] = zero
-        for m in range(n):
-            x = X[m, k]
-            if x != zero:
-                for i in range(n):
-                    col[i] -= Minv[m, i] * x
-        for i in range(n):
-            X[i, k] = col[i]
+    lo = 0
+    while lo < n:
+        hi = run_end(links, lo, n, blocks)
+        for k in range(lo, hi):
+            for i in range(lo, hi):
+                col[i] = zero
+            if blocks:
+                m = parent(links, k)
+                while m >= 0:
+                    subtract_row(Minv, m, X[m, k], col, lo, hi)
+                    m = parent(links, m)
+                m = k
+                while m < hi and (m == k or parent(links, m) >= k):
+                    subtract_row(Minv, m, X[m, k], col, lo, hi)
+                    m += 1
+            else:
+                for m in range(n):
+                    x = X[m, k]
+                    if x != zero:
+                        subtract_row(Minv, m, x, col, lo, hi)
+            for i in range(lo, hi):
+                X[i, k] = col[i]
+        lo = hi
 
 
 @njit(cache=True)
@@ -411,17 +479,22 @@ def aba_derivatives(links, frames, q, qd, tau, wrench, fall, fext, wext,
                             ws, cw, dw, DQ, DV)
     if code >= 0:
         return code
-    for k in range(n):                  # (D + I_a)^-1, column by column
-        if dense:
+    blocks = not dense and depth_first(links)
+    lo = 0
+    while lo < n:                       # (D + I_a)^-1, column by column
+        hi = run_end(links, lo, n, blocks)
+        for k in range(lo, hi):
+            if dense:
+                for i in range(n):
+                    col[i] = one if i == k else zero
+                cholesky_solve_factored(chol, col, col)
+            else:
+                ltl_inverse_column(links, frames, chol, k, col, lo, hi)
             for i in range(n):
-                col[i] = one if i == k else zero
-            cholesky_solve_factored(chol, col, col)
-        else:
-            ltl_inverse_column(links, frames, chol, k, col)
-        for i in range(n):
-            DT[i, k] = col[i]
-    times_minus_inverse(frames, DT, DQ, col)
-    times_minus_inverse(frames, DT, DV, col)
+                DT[i, k] = col[i]
+        lo = hi
+    times_minus_inverse(links, frames, DT, DQ, col, blocks)
+    times_minus_inverse(links, frames, DT, DV, col, blocks)
     code = matrix_status(DQ)
     if code < 0:
         code = matrix_status(DV)
