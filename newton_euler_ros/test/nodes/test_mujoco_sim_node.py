@@ -43,6 +43,7 @@ mujoco_sim_node as a process: the MuJoCo plant over real DDS.
 """
 import math
 import os
+import re
 import subprocess
 import sys
 import time
@@ -102,6 +103,20 @@ def node_cmd(tmp_path, **params):
 
 def t_of(msg):
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+
+
+def on_grid(stamps, origin=0.0, step=0.002):
+    """
+    Check that stamps lie on the tick grid, increasing; return the ticks.
+
+    Some states may be missing (dropped between the processes on a
+    loaded machine); the ones that arrive are ticks of the plant.
+    """
+    ticks = np.rint((np.asarray(stamps) - origin) / step).astype(int)
+    np.testing.assert_allclose(np.asarray(stamps) - origin, ticks * step,
+                               rtol=0, atol=1e-6)
+    assert (np.diff(ticks) > 0).all(), ticks
+    return ticks
 
 
 def command(values):
@@ -207,8 +222,7 @@ def test_holds_then_falls_as_mujoco_does(tmp_path):
             np.testing.assert_array_equal(msg.position, Q0)
             np.testing.assert_array_equal(msg.velocity, 0.0)
             np.testing.assert_array_equal(msg.effort, 0.0)
-        stamps = np.array([t_of(m) for m in run.states])
-        np.testing.assert_allclose(np.diff(stamps), 0.002, atol=1e-6)
+        on_grid([t_of(m) for m in run.states])
         assert clock, 'no /clock'
         held = run.last_diagnostics(lambda v: v['held'] == 'true')
         assert held['commands received'] == '0'
@@ -217,35 +231,46 @@ def test_holds_then_falls_as_mujoco_does(tmp_path):
         run.pub.publish(command(np.zeros(7)))
         ticks = 200
 
-        def release():
-            return next((k for k, m in enumerate(run.states)
+        def moved():
+            return next((m for m in run.states
                          if not np.array_equal(m.position, Q0)), None)
+        # the first moving state comes one tick after the release
         assert run.probe.spin_until(
-            lambda: release() is not None
-            and len(run.states) > release() + ticks, 30.0), run.node.log()
-        r = release()
-        after = run.states[r - 1:r + ticks]
-        np.testing.assert_allclose(
-            np.diff([t_of(m) for m in after]), 0.002, atol=1e-6)
+            lambda: moved() is not None and t_of(run.states[-1])
+            >= t_of(moved()) + (ticks - 1) * 0.002 - 1e-9, 30.0), \
+            run.node.log()
+        states = list(run.states)
         last_clock = clock[-1].clock
-        assert last_clock.sec + last_clock.nanosec * 1e-9 >= t_of(after[-1])
+        assert last_clock.sec + last_clock.nanosec * 1e-9 >= \
+            t_of(states[-1])
     finally:
         log = run.close()
-    assert 'brakes released' in log, log
+    # the node's log gives the simulated time of the release
+    released = re.search(r'first command at t = ([0-9.]+) s: brakes '
+                         r'released', log)
+    assert released, log
+    t_release = float(released.group(1))
+    steps = on_grid([t_of(m) for m in states], origin=t_release)
+    after = {k: m for k, m in zip(steps, states) if 0 < k <= ticks}
+    held = [m for k, m in zip(steps, states) if k <= 0]
+    assert held and all(np.array_equal(m.position, Q0) for m in held)
+    # a loaded machine may drop some states between the processes (the
+    # publisher keeps the last 100): most of them arrive
+    assert len(after) >= ticks // 2, sorted(after)
 
     # MuJoCo's own simulation of the same robot from the same state
     plant = MujocoPlant(load_mujoco('panda', timestep=0.001), Q0)
     plant.release()
     fell = 0.0
-    for j in range(ticks):
+    for k in range(1, ticks + 1):
         plant.advance(np.zeros(7), 0.002)
-        if j in (0, 1, 9, 49, 99, ticks - 1):
+        if k in after:
             q, qd = plant.state()
-            msg = after[j + 1]
+            msg = after[k]
             np.testing.assert_allclose(msg.position, q, rtol=0, atol=1e-9,
-                                       err_msg=f'tick {j + 1}')
+                                       err_msg=f'tick {k}')
             np.testing.assert_allclose(msg.velocity, qd, rtol=0,
-                                       atol=1e-9, err_msg=f'tick {j + 1}')
+                                       atol=1e-9, err_msg=f'tick {k}')
             np.testing.assert_array_equal(msg.effort, 0.0)
             fell = np.abs(q - Q0).max()
     assert fell > 0.05          # it did fall: 0.4 s without torques
