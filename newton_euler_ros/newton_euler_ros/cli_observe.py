@@ -298,7 +298,7 @@ def _intervals(t, flag):
 def _summary(args, model, obs, rec, out):
     """Return what the command found, as a dict (the --json object)."""
     from .core.observer import beyond_friction, suggest_thresholds
-    from .core.observer_thresholds import (rest_changes,
+    from .core.observer.thresholds import (rest_changes,
                                            suggest_state_thresholds)
     t = out.t
     resting = (np.abs(rec.qd) < obs.friction_width).all(axis=1)

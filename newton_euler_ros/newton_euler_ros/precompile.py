@@ -63,7 +63,7 @@ URDF = """<?xml version="1.0"?>
 </robot>
 """
 # the files whose functions numba compiles (and caches)
-COMPILED = ('core/kernels/', 'core/observer', 'ident/excite.py')
+COMPILED = ('core/kernels/', 'core/observer/', 'ident/excite.py')
 
 
 def sources_digest():

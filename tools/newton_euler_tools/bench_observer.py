@@ -34,15 +34,16 @@ import os
 import warnings
 
 from newton_euler_ros.core import load_robot
-from newton_euler_ros.core import observer as momentum
-from newton_euler_ros.core import observer_contact, observer_wrench
 from newton_euler_ros.core.dynamics import (coriolis_matrix, gravity_torques,
                                             jacobian, mass_matrix)
 from newton_euler_ros.core.kernels import (F_TOOL, run_jacobian,
                                            run_momentum_terms)
+from newton_euler_ros.core.observer import contact as observer_contact
 from newton_euler_ros.core.observer import (contact_step, external_wrench,
                                             initial_contact, initial_state,
                                             MomentumObserver, observer_step)
+from newton_euler_ros.core.observer import momentum
+from newton_euler_ros.core.observer import wrench as observer_wrench
 from numba import njit
 import numpy as np
 

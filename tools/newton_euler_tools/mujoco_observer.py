@@ -228,7 +228,7 @@ def suggest(scene, run, start):
     samples, the share of samples whose residual the probe heard).
     """
     from newton_euler_ros.core import MomentumObserver, observe_recording
-    from newton_euler_ros.core.observer_thresholds import suggest_thresholds
+    from newton_euler_ros.core.observer.thresholds import suggest_thresholds
     obs = MomentumObserver(scene.model, GAIN, thresholds=NO_THRESHOLD,
                            rest_reference=True)
     k = run['t'] >= start
@@ -263,7 +263,7 @@ def replay(scene, run, thresholds):
     published dates each change.  Unheard samples hold the flag.
     """
     from newton_euler_ros.core import MomentumObserver
-    from newton_euler_ros.core.observer_contact import (contact_step,
+    from newton_euler_ros.core.observer.contact import (contact_step,
                                                         initial_contact)
     obs = MomentumObserver(scene.model, GAIN, thresholds=thresholds,
                            rest_reference=True)

@@ -154,7 +154,7 @@ def onset(data, rec, push):
 
 def evaluate(data, rest_reference=True):
     """Return the targets of one seed's recordings, a dict of figures."""
-    from newton_euler_ros.core.observer_thresholds import suggest_thresholds
+    from newton_euler_ros.core.observer.thresholds import suggest_thresholds
     path, _ = data['runs']['free_1']
     _, out = observed(data['urdf'], path, 10.0, rest_reference)
     thresholds = suggest_thresholds(out)
@@ -216,7 +216,7 @@ def moving_evaluate(data, state=True):
     poses, and the pushes reported (resting / moving) and within 0.2 s
     of their onset.
     """
-    from newton_euler_ros.core.observer_thresholds import (
+    from newton_euler_ros.core.observer.thresholds import (
         suggest_state_thresholds, suggest_thresholds)
     _, out = observed(data['urdf'], data['runs']['free_1'][0], 10.0)
     if state:

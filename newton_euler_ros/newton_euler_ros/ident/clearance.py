@@ -110,7 +110,7 @@ class Body:
 def _bodies_from_urdf(model, text, urdf_path):
     """Bodies of a URDF chain; and the links bounded by their origin."""
     from ..core.urdf import parse_urdf
-    from ..core.urdf_tree import attached
+    from ..core.urdf.tree import attached
     _, _, links, joints = parse_urdf(text, urdf_path or 'URDF')
     shapes = link_shapes(text, urdf_path)
     moving = list(model.info['urdf']['moving'])

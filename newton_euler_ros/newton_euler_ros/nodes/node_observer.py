@@ -189,7 +189,7 @@ class NodeObserver:
             msg = WrenchStamped()
             msg.header.frame_id = link
             out.append((link, msg, np.zeros(6)))
-        #: two links or more: estimated jointly (core/observer_wrenches.py)
+        #: two links or more: estimated jointly (core/observer/wrenches.py)
         self._joint = None
         own = momentum.own_joints(model, links) if len(links) > 1 else ()
         for link, joints in zip(links, own):

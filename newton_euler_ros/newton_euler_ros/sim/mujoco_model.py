@@ -58,7 +58,7 @@ from ..core.errors import RobotFileError
 from ..core.robot_file import is_urdf, load_robot
 from ..core.text import clip, read_text
 from ..core.urdf import MAX_BYTES, read_urdf_text, urdf_model
-from ..core.urdf_writer import model_to_urdf
+from ..core.urdf.writer import model_to_urdf
 
 MESH_FORMATS = ('.stl', '.obj', '.msh')
 COMPILER = {'discardvisual': 'true', 'fusestatic': 'false',

@@ -22,7 +22,7 @@ controller starts: time runs, nothing moves.  :meth:`contact_wrenches`
 gives the wrench the environment applies to each link in contact, in the
 world (base) axes, the moment about the link's origin: the sign and
 point of the momentum observer's estimate
-(:func:`~..core.observer_wrench.external_wrench`).  Nothing here imports
+(:func:`~..core.observer.wrench.external_wrench`).  Nothing here imports
 ROS.
 """
 import numpy as np

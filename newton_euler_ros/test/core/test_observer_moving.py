@@ -30,7 +30,7 @@ import warnings
 from newton_euler_ros.core import load_robot
 from newton_euler_ros.core.observer import (drive_options, MomentumObserver,
                                             observe_recording)
-from newton_euler_ros.core.observer_thresholds import (
+from newton_euler_ros.core.observer.thresholds import (
     suggest_state_thresholds, suggest_thresholds)
 import numpy as np
 import pytest

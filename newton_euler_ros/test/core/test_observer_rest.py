@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-The contact test's rest reference (core/observer_contact.py), rule by rule.
+The contact test's rest reference (core/observer/contact.py), rule by rule.
 
 A two-joint arm at 100 Hz; the residual is written directly, as the
 observer would give it: a resting arm holds a friction of any value in
@@ -35,7 +35,7 @@ from newton_euler_ros.core.observer import (contact_step, initial_contact,
                                             MomentumObserver,
                                             ObserverRecording,
                                             suggest_thresholds)
-from newton_euler_ros.core.observer_contact import (CONFIRM, EXPIRE,
+from newton_euler_ros.core.observer.contact import (CONFIRM, EXPIRE,
                                                     REST_TRAVEL, SETTLE)
 import numpy as np
 import pytest

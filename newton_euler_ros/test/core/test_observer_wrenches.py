@@ -33,7 +33,7 @@ from newton_euler_ros.core.errors import DynamicsInputError
 from newton_euler_ros.core.observer import (contact_step, external_wrench,
                                             initial_contact, initial_state,
                                             MomentumObserver, observer_step)
-from newton_euler_ros.core.observer_wrenches import (external_wrenches,
+from newton_euler_ros.core.observer.wrenches import (external_wrenches,
                                                      own_joints,
                                                      separability)
 import numpy as np

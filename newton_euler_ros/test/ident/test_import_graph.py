@@ -21,7 +21,9 @@ reader), the package's own import graph is built and searched for a
 cycle, which the failure prints (``constants -> effort -> fit ->
 constants`` before ``fit.predict`` moved to ``ident.torques``; in
 ``sim``, ``simulate -> mujoco_scene -> simulate`` before the engine
-choice moved to ``sim.run``).
+choice moved to ``sim.run``).  Inside ``core``, the packages
+``observer`` and ``urdf`` re-export their modules' names, and no module
+of theirs imports its own package.
 """
 import import_graph as ig
 import pytest
@@ -45,6 +47,22 @@ def test_ident_steps_import_in_one_direction():
     assert ident + 'effort' in graph[ident + 'constants']
     assert ident + 'fit' not in graph[ident + 'effort']
     assert graph[ident + 'torques'] == set()
+
+
+@pytest.mark.parametrize('package, modules', [
+    ('observer', {'momentum', 'contact', 'motion', 'thresholds', 'wrench',
+                  'wrenches'}),
+    ('urdf', {'read', 'chain', 'tree', 'whole', 'writer'}),
+])
+def test_core_packages_import_their_modules_never_themselves(package,
+                                                             modules):
+    """``core.observer``, ``core.urdf``: the package re-exports, one way."""
+    graph = ig.graph(ig.modules('core'))
+    top = f'newton_euler_ros.core.{package}'
+    members = {m for m in graph if m.startswith(top + '.')}
+    assert members == {f'{top}.{m}' for m in modules}
+    assert graph[top] <= members
+    assert [m for m in members if top in graph[m]] == []
 
 
 def test_the_cycle_check_sees_a_cycle(tmp_path):

@@ -42,8 +42,8 @@ import os
 import subprocess
 import sys
 
-from newton_euler_ros.core.observer_contact import rest_deviations
-from newton_euler_ros.core.observer_thresholds import FACTOR
+from newton_euler_ros.core.observer.contact import rest_deviations
+from newton_euler_ros.core.observer.thresholds import FACTOR
 from newton_euler_tools.observer_targets import (observed, pushes_felt,
                                                  truth_at)
 import numpy as np

@@ -16,14 +16,14 @@
 The observer's contact test: thresholds, and the rest reference.
 
 :func:`contact_step` sets a joint in contact when ``|r_j|`` exceeds its
-threshold plus its static friction allowance (``observer.py``), with
+threshold plus its static friction allowance (``momentum.py``), with
 hysteresis; and, the observer's ``rest_reference`` on, by the rest
 reference's test below.
 
 The rest reference: a push on a resting arm, felt early.
 
 A joint at rest holds a static friction anywhere in its band, so the
-static friction allowance (``observer.py``) lets a push through only
+static friction allowance (``momentum.py``) lets a push through only
 once it exceeds the band.  But a resting arm holds that friction still:
 what changes is the push.  Once the whole arm has come to rest (every
 joint slower than ``REST_SPEED`` and within ``REST_TRAVEL`` of where it
@@ -56,8 +56,8 @@ import math
 from numba import njit
 import numpy as np
 
-from .kernels._jit import ENTRY
-from .observer_motion import motion_step, MotionState, state_thresholds
+from .motion import motion_step, MotionState, state_thresholds
+from ..kernels._jit import ENTRY
 
 #: rad/s (m/s): every joint slower than this for the arm to rest
 REST_SPEED = 0.01
@@ -259,7 +259,7 @@ class ContactState:
     in_contact: bool = False
     count: int = 0          # contacts begun (false -> true)
     rest: RestState = None  # the rest reference (its own flags)
-    # the lagged speeds and accelerations (``observer_motion.py``)
+    # the lagged speeds and accelerations (``motion.py``)
     motion: MotionState = None
     threshold: np.ndarray = None    # per joint, the last sample's
 
@@ -279,10 +279,10 @@ def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
     (``state.allowance``), added to every threshold; None: none.  With
     the sample's stamp ``t`` (s), ``q`` and ``qd`` (model order), and the
     observer's ``rest_reference`` on, a joint is also in contact by the
-    rest reference's test (``observer_contact.py``).  With ``t`` and
+    rest reference's test (``contact.py``).  With ``t`` and
     ``qd``, each threshold grows with the joint's speed and acceleration
     by the observer's ``speed_thresholds`` and
-    ``acceleration_thresholds`` (``observer_motion.py``; the thresholds
+    ``acceleration_thresholds`` (``motion.py``; the thresholds
     alone without them, or without ``t``).
     """
     if allowance is None:

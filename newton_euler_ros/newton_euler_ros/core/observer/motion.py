@@ -37,7 +37,7 @@ going backwards, restarts the difference (the lagged values are kept).
 ``a``, ``b``, ``c`` are ``observer.thresholds``,
 ``observer.speed_thresholds`` and ``observer.acceleration_thresholds``;
 with ``b = c = 0`` the threshold is ``a`` exactly, as before.
-:func:`.observer_thresholds.suggest_state_thresholds` fits them on a
+:func:`.thresholds.suggest_state_thresholds` fits them on a
 free recording.
 """
 import math
@@ -45,7 +45,7 @@ import math
 from numba import njit
 import numpy as np
 
-from .kernels._jit import ENTRY
+from ..kernels._jit import ENTRY
 
 # rows of MotionState.rows (n columns)
 _SPEED, _ACCEL, _QD_PREV = 0, 1, 2

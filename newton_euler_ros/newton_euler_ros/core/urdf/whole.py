@@ -36,11 +36,11 @@ The whole URDF tree below a base link as one model (no tip given).
 """
 import numpy as np
 
-from .errors import RobotFileError
-from .inertia import triangle_note
-from .model import make_chain
-from .text import clip
-from .urdf_tree import combine, fixed_above, MOVING
+from .tree import combine, fixed_above, MOVING
+from ..errors import RobotFileError
+from ..inertia import triangle_note
+from ..model import make_chain
+from ..text import clip
 
 
 class _Walk:

@@ -22,16 +22,15 @@ placement (those after the last moving joint make the tool transform);
 every link rigidly attached to a chain link (fixed joints, and subtrees
 off the chain, their moving joints locked at zero and a mimic joint at
 its offset) merges into that link's body by the parallel-axis theorem.
-The whole tree (no tip) is ``urdf_whole.tree_model``.
+The whole tree (no tip) is ``whole.tree_model``.
 """
 import numpy as np
 
-from .errors import RobotFileError
-from .inertia import triangle_note
-from .model import make_chain
-from .text import clip
-from .urdf_tree import (attached, chain_ends, combine, fixed_above,
-                        MOVING)
+from .tree import attached, chain_ends, combine, fixed_above, MOVING
+from ..errors import RobotFileError
+from ..inertia import triangle_note
+from ..model import make_chain
+from ..text import clip
 
 
 def _short(text, limit=200):

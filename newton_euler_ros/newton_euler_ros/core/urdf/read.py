@@ -16,7 +16,7 @@
 Robots from URDF: the whole tree below a base link, or the chain to a tip.
 
 Without ``tip``: the whole tree below ``base`` (default: the root link;
-:mod:`~newton_euler_ros.core.urdf_whole`).  With ``tip``, the chain:
+:mod:`~newton_euler_ros.core.urdf.whole`).  With ``tip``, the chain:
 
 - The chain runs from ``base`` to ``tip``.  Its ``revolute``,
   ``continuous`` and ``prismatic`` joints are the model's joints, in
@@ -45,7 +45,7 @@ entities; text capped at :data:`MAX_BYTES`, documents at
 :data:`MAX_ELEMENTS` links plus joints; meshes never read.  Every error is
 a :class:`~newton_euler_ros.core.errors.RobotFileError` naming the source
 (the file, or ``robot_description``), the element and the attribute.
-Writing: :mod:`~newton_euler_ros.core.urdf_writer`.
+Writing: :mod:`~newton_euler_ros.core.urdf.writer`.
 """
 import math
 import os
@@ -56,15 +56,14 @@ import defusedxml
 import defusedxml.ElementTree as DET
 import numpy as np
 
-from .drives import read_drives
-from .errors import RobotFileError, RobotFileWarning
-from .inertia import format_moments, Note, principal_moments, triangle_note
-from .model import pose_matrix, rpy_matrix
-from .text import clip, read_text
-from .urdf_chain import chain_model
-from .urdf_tree import check_link, floating_root_base, mimic_cycle
-from .urdf_whole import tree_model
-from .urdf_writer import matrix_rpy, model_to_urdf  # noqa: F401 (API)
+from .chain import chain_model
+from .tree import check_link, floating_root_base, mimic_cycle
+from .whole import tree_model
+from ..drives import read_drives
+from ..errors import RobotFileError, RobotFileWarning
+from ..inertia import format_moments, Note, principal_moments, triangle_note
+from ..model import pose_matrix, rpy_matrix
+from ..text import clip, read_text
 
 MAX_BYTES = 16 * 1024 * 1024
 #: links plus joints: robots have hundreds (a dual-arm TIAGo 350); a
@@ -441,7 +440,7 @@ def urdf_model(text, label='robot_description', base=None, tip=None,
     """
     Build the model of URDF text; return (model, warnings, report).
 
-    Without ``tip``: the whole tree below ``base`` (``urdf_whole``).
+    Without ``tip``: the whole tree below ``base`` (``whole``).
     With it, the chain; ``report`` describes what was made of the tree:
     the chain's links and joints, the merged fixed joints, the lumped
     subtrees and the frames rigidly attached to the base and to the tip

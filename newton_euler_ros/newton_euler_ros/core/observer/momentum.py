@@ -69,7 +69,7 @@ constants and static friction from a model that has them.
 
 Signs and frames.  The residual is the joint torque the environment
 applies, ``tau_ext = J^T F_ext``; :func:`external_wrench` (in
-:mod:`.observer_wrench`) returns ``F_ext``, the wrench the environment
+:mod:`.wrench`) returns ``F_ext``, the wrench the environment
 applies to the end effector, in base axes.
 """
 from dataclasses import dataclass, field
@@ -78,20 +78,15 @@ import math
 from numba import njit
 import numpy as np
 
-from .calling import (F8, MAT, PACKED, Refused, status_error,
-                      strict_entry, VEC, vector, workspace)
-from .drives import DEFAULT_COULOMB_WIDTH
-from .errors import DynamicsInputError
-from .kernels import NONFINITE, run_momentum_terms, SIZE
-from .kernels._jit import ENTRY, uses_kernels
-from .observer_contact import (contact_step, ContactState,  # noqa: F401
-                               initial_contact, RestState)
-from .observer_thresholds import (beyond_friction,  # noqa: F401
-                                  suggest_thresholds)
-from .observer_wrench import external_wrench, felt_directions  # noqa: F401
-from .observer_wrenches import (external_wrenches,  # noqa: F401
-                                own_joints, separability, Wrenches)
-from .workspace import Workspace
+from .contact import contact_step, initial_contact
+from .wrench import external_wrench
+from ..calling import (F8, MAT, PACKED, Refused, status_error,
+                       strict_entry, VEC, vector, workspace)
+from ..drives import DEFAULT_COULOMB_WIDTH
+from ..errors import DynamicsInputError
+from ..kernels import NONFINITE, run_momentum_terms, SIZE
+from ..kernels._jit import ENTRY, uses_kernels
+from ..workspace import Workspace
 
 # this file's compiled functions call kernels: a kernel edit must
 # recompile them (numba's cache stamps a function with its own file only)
@@ -236,12 +231,12 @@ class MomentumObserver:
         friction allowance.
     speed_thresholds, acceleration_thresholds : per joint (>= 0), the
         threshold's growth per rad/s of the joint's speed and per rad/s^2
-        of its acceleration (``observer_motion.py``); 0: constant.
+        of its acceleration (``motion.py``); 0: constant.
     hysteresis : a joint in contact is released when |r| falls below
         this fraction of its threshold, plus the allowance
         (0 < hysteresis <= 1).
     rest_reference : also test, once the whole arm rests, each residual's
-        change from the value it settled to (``observer_contact.py``): a
+        change from the value it settled to (``contact.py``): a
         push on a resting arm is felt within the friction band.
     ws : a :class:`Workspace` of the model (a new one by default); not
         shared with another thread.
@@ -515,7 +510,7 @@ class ObserverRecording:
     rest_reference: bool = False    # whether its contact test was on
     max_gap: float = 0.1
     speed: np.ndarray = None        # (m, n) lagged |qd|, |qdd|
-    acceleration: np.ndarray = None  # (``observer_motion.py``)
+    acceleration: np.ndarray = None  # (``motion.py``)
 
 
 def observe_recording(obs, T, Q, QD, TAU):

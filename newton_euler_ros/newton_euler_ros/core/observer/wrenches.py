@@ -15,9 +15,9 @@
 """
 The wrenches of several end effectors of a tree, estimated jointly.
 
-The residual ``r`` of :mod:`.observer` is ``sum_i J_i^T F_i`` over the
+The residual ``r`` of :mod:`.momentum` is ``sum_i J_i^T F_i`` over the
 frames pushed.  Estimating each frame's wrench alone
-(:func:`.observer_wrench.external_wrench` with ``frame=``) reads a push
+(:func:`.wrench.external_wrench` with ``frame=``) reads a push
 on one hand at the other whenever a joint moves both (a torso): the
 other hand's solve explains the torso's residual with a wrench of its
 own.  :func:`external_wrenches` solves ``J_all^T F_all = r`` for all
@@ -52,10 +52,10 @@ import functools
 
 import numpy as np
 
-from .calling import vector
-from .errors import DynamicsInputError
-from .frames import AXES, frame_target, jacobian
-from .tree import coordinates, support
+from ..calling import vector
+from ..errors import DynamicsInputError
+from ..frames import AXES, frame_target, jacobian
+from ..tree import coordinates, support
 
 #: names of the six wrench components, for :meth:`Wrenches.text`
 COMPONENTS = ('fx', 'fy', 'fz', 'mx', 'my', 'mz')
@@ -187,7 +187,7 @@ def external_wrenches(obs, q, r, frames, *, axes='base', allowance=None,
     reported with the moment about its origin in base axes or its own
     (``axes='link'``).  Which joints felt a contact: ``felt`` (n bools,
     model order) if given; else ``contact``, a :class:`ContactState`
-    just updated by :func:`~.observer_contact.contact_step` (its band
+    just updated by :func:`~.contact.contact_step` (its band
     flags, and the rest reference's when the observer has it on); else
     ``|r_j| > threshold_j + allowance_j`` with the observer's thresholds
     and ``allowance`` (the state's static friction allowance; None:

@@ -15,7 +15,7 @@
 """
 Contact thresholds of the momentum observer from a free-motion recording.
 
-The contact test (:func:`.observer.contact_step`) compares ``|r_j|`` with
+The contact test (:func:`.contact.contact_step`) compares ``|r_j|`` with
 the joint's threshold plus its static friction allowance; over a
 recording with nothing touching the arm, what lies beyond the allowance
 is noise and model error, and thresholds a margin above its peak keep a
@@ -25,7 +25,7 @@ import math
 
 import numpy as np
 
-from .observer_contact import rest_deviations
+from .contact import rest_deviations
 
 #: suggested threshold = this x the free-motion peak beyond the allowance:
 #: the peaks of other recordings of like motion reached up to 1.6 x that
@@ -61,7 +61,7 @@ def suggest_state_thresholds(recording, factor=FACTOR):
     """
     Return per-joint ``(a, b, c)`` (3 arrays (n,)) from a free recording.
 
-    The threshold ``a + b s + c u`` of ``observer_motion.py`` (``s``,
+    The threshold ``a + b s + c u`` of ``motion.py`` (``s``,
     ``u``: the lagged speed and acceleration the recording carries)
     that is smallest on average over the recording's samples while
     lying above ``|r|`` beyond the static friction allowance at every
@@ -115,7 +115,7 @@ def rest_changes(recording, factor=FACTOR, thresholds=None):
     Return per joint the largest change from the rest value (n,).
 
     What the rest reference's test compares with the thresholds
-    (:func:`.observer_contact.rest_deviations`, a change held for its
+    (:func:`.contact.rest_deviations`, a change held for its
     confirmation time), run with the thresholds the allowance test
     alone suggests (its calm test depends on them), or with
     ``thresholds`` ((n,) or one row per sample); zeros when the recording's observer had the rest

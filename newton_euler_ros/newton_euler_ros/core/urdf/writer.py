@@ -17,7 +17,7 @@ import math
 
 import numpy as np
 
-from .model import REVOLUTE
+from ..model import REVOLUTE
 
 
 def matrix_rpy(R):

@@ -16,7 +16,7 @@
 """
 The momentum observer's end-effector wrench: F = (J J^T + lambda^2 I)^-1 J r.
 
-The residual ``r`` of :mod:`.observer` is the joint torque the
+The residual ``r`` of :mod:`.momentum` is the joint torque the
 environment applies, ``tau_ext = J^T F_ext``.  :func:`external_wrench`
 returns ``F_ext = [f; m]``, the wrench the environment applies *to* the
 end effector (a wrist force/torque sensor's sign), in base-frame axes,
@@ -34,14 +34,14 @@ import math
 from numba import njit
 import numpy as np
 
-from .calling import (BOOL, F8, INT, MAT, out_array, PACKED, Refused,
-                      status_error, strict_entry, TARGET, VEC, vector)
-from .dynamics import jacobian
-from .errors import DynamicsInputError
-from .frames import AXES, frame_target
-from .kernels import (cholesky_solve, F_ROWS, F_TOOL, F_TREE, run_jacobian,
-                      SIZE, T_TOOL)
-from .kernels._jit import ENTRY, uses_kernels
+from ..calling import (BOOL, F8, INT, MAT, out_array, PACKED, Refused,
+                       status_error, strict_entry, TARGET, VEC, vector)
+from ..dynamics import jacobian
+from ..errors import DynamicsInputError
+from ..frames import AXES, frame_target
+from ..kernels import (cholesky_solve, F_ROWS, F_TOOL, F_TREE, run_jacobian,
+                       SIZE, T_TOOL)
+from ..kernels._jit import ENTRY, uses_kernels
 
 # this file's compiled functions call kernels: a kernel edit must
 # recompile them (numba's cache stamps a function with its own file only)
@@ -160,7 +160,7 @@ def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
     (``axes='link'``), from J of that frame.  Only the joints between it
     and the base take part; on a tree a push elsewhere that shows on
     those joints (a torso's) is read as this frame's: estimate several
-    frames jointly with :func:`.observer_wrenches.external_wrenches`.
+    frames jointly with :func:`.wrenches.external_wrenches`.
     """
     if frame is not None:
         return _wrench_at_frame(obs, q, r, out, frame, axes)

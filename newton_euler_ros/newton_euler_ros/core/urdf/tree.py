@@ -26,10 +26,10 @@ import math
 
 import numpy as np
 
-from .errors import RobotFileError
-from .inertia import merge_bodies
-from .model import PRISMATIC, REVOLUTE
-from .text import clip
+from ..errors import RobotFileError
+from ..inertia import merge_bodies
+from ..model import PRISMATIC, REVOLUTE
+from ..text import clip
 
 
 #: the URDF joint types that are joints of a model, and their kind
