@@ -78,10 +78,13 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
     velocities and accelerations, and its parent takes the wrench it
     transmits.  On a chain the running values stay in registers; a
     branch point stores its state for its later children (``W_X``) and
-    sums what they carry back (``W_ACC``).  The steps are written inline,
-    in one function: numba passes arrays and tuples between functions at a
-    cost (measured: 35% more per call with the steps as functions, inlined
-    or not).  Cost: about 250 flops per body, O(nb).  Every vector of link
+    sums what they carry back (``W_ACC``).  The two passes are
+    :func:`forward_pass` and :func:`backward_pass`; the workspace carries
+    each body's net force and moment from one to the other.  Within a pass
+    the per-body step is written inline in the loop: numba passes arrays
+    and tuples between functions at a cost (measured: 35% more per call
+    with the body steps as functions, inlined or not).  Cost: about 250
+    flops per body, O(nb).  Every vector of link
     j is in kernel frame j, whose z axis is joint j's axis through its
     origin.
 
@@ -118,6 +121,25 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
         Output.
 
     """
+    forward_pass(links, frames, qd, v, qdd, gravity_on, velocity_on, ws)
+    backward_pass(links, frames, wrench, wrench_mode, fext, link_wrenches,
+                  ws, tau)
+
+
+@njit(cache=True, inline='always')
+def forward_pass(links, frames, qd, v, qdd, gravity_on, velocity_on, ws):
+    """
+    Run the forward steps, base to tip: velocities and accelerations out.
+
+    The seed's eqs. (19)-(21), body by body: from the parent's angular
+    velocity ``w``, reference velocity ``r``, angular acceleration ``al``
+    and origin acceleration ``ae`` (its axes) to body j's (frame j axes),
+    then body j's net force m a_c (``W_F``) and net moment about its
+    centre of mass (``W_N``) into the workspace, which is all the backward
+    pass reads of it.  A branch point keeps its state for its later
+    children (``W_X``) and zeroes the sum they will carry back
+    (``W_ACC``).  Arguments as :func:`recursion`'s.
+    """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
     half = frames[F_CONST, C_HALF]
@@ -132,9 +154,6 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
     r = (zero, zero, zero)
     al = (zero, zero, zero)
 
-    # ---- forward steps, base to tip: the seed's eqs. (19)-(21) ----
-    # from the parent's w, r, al, ae (its frame's axes) to link j's (frame
-    # j axes); link j's net force m a_c and moment about its com into ws
     for j in range(nb):
         par = parent(links, j)
         if par != j - 1:        # a branch: start from the parent's state
@@ -222,7 +241,25 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
         ws[j, W_N + 1] = Nn[1]
         ws[j, W_N + 2] = Nn[2]
 
-    # ---- backward steps, tip to base: the force and moment balance ----
+
+@njit(cache=True, inline='always')
+def backward_pass(links, frames, wrench, wrench_mode, fext, link_wrenches,
+                  ws, tau):
+    """
+    Run the backward steps, tip to base: forces and moments in, torques.
+
+    Body by body, the force and moment (about O_j, frame j axes) that body
+    j exerts on its children and its environment: what its children carry
+    back, the end effector's wrench at the tool's body (``wrench_mode``,
+    :func:`tip_wrench`), the links' own wrenches (``link_wrenches``,
+    :func:`link_wrench`), and its net force and moment from
+    :func:`forward_pass`; joint j takes the moment about (revolute) or the
+    force along (prismatic) its axis, and the rest goes to the parent.
+    Arguments as :func:`recursion`'s.
+    """
+    nb = links.shape[0]
+    zero = frames[F_CONST, C_ZERO]
+    mimic = has_mimic(links, frames)
     # f, nm hold the force and the moment (about O_j) that link j exerts on
     # its children and its environment, in frame j axes; the wrench the
     # end effector exerts (the seed's "f_{n+1}, tau_{n+1}") enters at the
