@@ -136,12 +136,18 @@ def test_send_through_the_node_and_record_a_bag(tmp_path):
     assert status == [0, 0], node.log() + sim.log()
     # the bag is a complete rosbag2 the identification commands read,
     # with every joint state the simulator published while it recorded
-    # (its stamps are t0 + k 4 ms)
+    # (its stamps are t0 + k 4 ms), but for those the recorder says it
+    # dropped (a machine too busy to keep its lag under MAX_LAG_S)
     states = read_joint_states(str(bag), NAMES)
     # from t = 0 to 0.5 s past the trajectory's end: over 3 s at 250 Hz
     assert states.counts['messages'] == states.counts['kept'] >= 700
-    assert np.all(np.diff(states.stamps_ns) == 4_000_000), \
-        'a joint state was lost'
+    steps = np.diff(states.stamps_ns)
+    assert np.all(steps % 4_000_000 == 0) and np.all(steps > 0), steps
+    missing = int((steps // 4_000_000 - 1).sum())
+    said = re.search(r'recorded (\d+) messages .*, (none|\d+) dropped', out)
+    assert said and int(said.group(1)) == len(states.stamps_ns), out
+    dropped = 0 if said.group(2) == 'none' else int(said.group(2))
+    assert missing <= dropped, f'{missing} states lost, {dropped} said: {out}'
     np.testing.assert_allclose(states.q[0], Q0, atol=1e-12)
     # the node filled the efforts (gravity): sent straight to the
     # simulator, the scene's soft PD alone leaves joint 2 about 0.3 rad
