@@ -126,27 +126,22 @@ def our_methods(model):
                  'inverse_dynamics(model, q, qd, qdd, ws=ws, out=tau)', ns)
     yield Method('tau', 'float32', 'float32',
                  'f32.inverse_dynamics(q, qd, qdd, out=tau32)', ns)
-    yield Method('D', 'float64, CRBA', 'ours',
-                 'mass_matrix(model, q, ws=ws, out=D)', ns,
-                 note='the default of mass_matrix')
-    yield Method('D', 'float64, n recursions', 'ours',
-                 "mass_matrix(model, q, method='newton_euler', ws=ws, out=D)",
-                 ns)
-    yield Method('D', 'float32, CRBA', 'float32',
-                 'f32.mass_matrix(q, out=D32)', ns)
-    yield Method('D', 'float32, n recursions', 'float32',
-                 "f32.mass_matrix(q, method='newton_euler', out=D32)", ns)
-    yield Method('C', 'float64, composite, O(n^2)', 'ours',
-                 'coriolis_matrix(model, q, qd, ws=ws, out=C)', ns,
-                 note='the default of coriolis_matrix')
-    yield Method('C', 'float64, n recursions', 'ours',
-                 "coriolis_matrix(model, q, qd, method='newton_euler', ws=ws, "
-                 'out=C)', ns)
-    yield Method('C', 'float32, composite, O(n^2)', 'float32',
-                 'f32.coriolis_matrix(q, qd, out=C32)', ns)
-    yield Method('C', 'float32, n recursions', 'float32',
-                 "f32.coriolis_matrix(q, qd, method='newton_euler', "
-                 'out=C32)', ns)
+    # D and C alike: the default algorithm and n recursions, float64 and
+    # float32
+    for out, function, args, default in (
+            ('D', 'mass_matrix', 'q', 'CRBA'),
+            ('C', 'coriolis_matrix', 'q, qd', 'composite, O(n^2)')):
+        yield Method(out, f'float64, {default}', 'ours',
+                     f'{function}(model, {args}, ws=ws, out={out})', ns,
+                     note=f'the default of {function}')
+        yield Method(out, 'float64, n recursions', 'ours',
+                     f"{function}(model, {args}, method='newton_euler', "
+                     f'ws=ws, out={out})', ns)
+        yield Method(out, f'float32, {default}', 'float32',
+                     f'f32.{function}({args}, out={out}32)', ns)
+        yield Method(out, 'float32, n recursions', 'float32',
+                     f"f32.{function}({args}, method='newton_euler', "
+                     f'out={out}32)', ns)
     yield Method('C', 'central differences of D', 'fd',
                  'fd(model, q, qd, h_c, True, ws=ws)', ns,
                  note=f'2n CRBA calls, h = eps^(1/3) = {CENTRAL_STEP:.1e}')
