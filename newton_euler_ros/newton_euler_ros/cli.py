@@ -53,7 +53,8 @@ from .cli_export import register as register_export  # noqa: E402
 from .cli_identify import register as register_identify  # noqa: E402
 from .cli_loop import register as register_loop  # noqa: E402
 from .cli_observe import register as register_observe  # noqa: E402
-from .cli_options import chain_options, robot_argument  # noqa: E402
+from .cli_options import (chain_options, json_option,  # noqa: E402
+                          robot_argument)
 from .cli_report import (format_table, mass_counted,  # noqa: E402
                          source, tree_lines, types_of)
 from .cli_ros import (register as register_ros, RosCliError,  # noqa: E402
@@ -420,8 +421,7 @@ def build_parser():
                          'environment (N, N m), moment about its origin',
                     'axes of --wrench and of the Jacobian (default base; '
                     "end_effector: the frame's own)")
-    dyn.add_argument('--json', action='store_true',
-                     help='print one JSON object')
+    json_option(dyn, 'print one JSON object')
     dyn.add_argument('--states', metavar='FILE.json',
                      help='evaluate a JSON list of {"q","qd","qdd","wrench"}'
                           ' and print a JSON list')
@@ -442,8 +442,7 @@ def build_parser():
                      help='scene YAML file or bundled scene name')
     sim.add_argument('--duration', type=float, metavar='T',
                      help="simulated seconds (default: the scene's)")
-    sim.add_argument('--json', action='store_true',
-                     help='print the summary as one JSON object')
+    json_option(sim, 'print the summary as one JSON object')
     sim.add_argument('--no-feedforward', action='store_true',
                      help='PD alone, without the inverse-dynamics '
                           'feedforward (for comparison)')

@@ -28,6 +28,8 @@ and an existing one only with ``--overwrite``.
 """
 import sys
 
+from .cli_options import model_argument, overwrite_option
+
 # ident.export.FORMATS (test_export checks they agree): the identification
 # package is imported only when a command of it runs, never by `cli`
 FORMATS = ('ur', 'franka')
@@ -49,8 +51,7 @@ def register(subparsers):
     exp = subparsers.add_parser(
         'export', help="write an identified URDF's inertials as UR's "
                        "physical_parameters.yaml or Franka's inertials.yaml")
-    exp.add_argument('model', metavar='MODEL.urdf',
-                     help='the identified URDF (newton-euler identify -o)')
+    model_argument(exp, 'the identified URDF (newton-euler identify -o)')
     exp.add_argument('--format', required=True, choices=FORMATS,
                      help="ur: ur_description's physical_parameters.yaml; "
                           "franka: franka_description's inertials.yaml")
@@ -65,6 +66,5 @@ def register(subparsers):
                      help="the links' name prefix (ur's tf_prefix, e.g. "
                           "'fr3_' or 'panda_'; default: the one naming "
                           'every link needed)')
-    exp.add_argument('--overwrite', action='store_true',
-                     help='replace OUT.yaml if it exists')
+    overwrite_option(exp, 'replace OUT.yaml if it exists')
     exp.set_defaults(func=cmd_export)

@@ -47,7 +47,7 @@ import time
 
 import numpy as np
 
-from .cli_options import recording_options
+from .cli_options import model_argument, overwrite_option, recording_options
 
 EXIT_BAD_INPUT = 2
 
@@ -84,14 +84,12 @@ def register(subparsers):
                      help='Coulomb smoothing width of tanh(qd / EPS), rad/s '
                           '(default: chosen on held-out blocks among 0.005 '
                           "... 0.1 and the nominal URDF's)")
-    ide.add_argument('--overwrite', action='store_true',
-                     help='allow -o to be the input URDF')
+    overwrite_option(ide, 'allow -o to be the input URDF')
     ide.set_defaults(func=_one_line_exit_2(cmd_identify))
     rep = subparsers.add_parser(
         'replay', help="the model's torques along a recording, against the "
                        'measured efforts (CSV, plot)')
-    rep.add_argument('model', metavar='MODEL.urdf',
-                     help='the URDF whose torques are replayed')
+    model_argument(rep, 'the URDF whose torques are replayed')
     rep.add_argument('bag', metavar='BAG', help='rosbag2 directory (MCAP or '
                                                 'sqlite3)')
     _common(rep)

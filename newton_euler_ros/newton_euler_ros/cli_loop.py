@@ -42,7 +42,7 @@ import numpy as np
 # one line on stderr and exit status 2, as identify and replay
 from .cli_identify import (_describe, _fail, _load_urdf, _one_line_exit_2,
                            _payload_link)
-from .cli_options import recording_options
+from .cli_options import json_option, model_argument, recording_options
 
 
 def register(subparsers):
@@ -51,8 +51,7 @@ def register(subparsers):
         'excite', help='write an excitation trajectory (Fourier series '
                        'optimised for identification) as JointTrajectory '
                        'JSON')
-    exc.add_argument('model', metavar='MODEL.urdf',
-                     help='the URDF whose limits the trajectory keeps')
+    model_argument(exc, 'the URDF whose limits the trajectory keeps')
     exc.add_argument('--base', metavar='LINK', required=True,
                      help='first link of the chain')
     exc.add_argument('--tip', metavar='LINK', required=True,
@@ -111,8 +110,7 @@ def register(subparsers):
     pay = subparsers.add_parser(
         'payload', help='estimate the mass, centre of mass and inertia of '
                         'a payload at the tip (or a link) from a recording')
-    pay.add_argument('model', metavar='MODEL.urdf',
-                     help='the arm without the payload (identified URDF)')
+    model_argument(pay, 'the arm without the payload (identified URDF)')
     pay.add_argument('bag', metavar='BAG', help='rosbag2 directory')
     recording_options(pay, 'last link of the chain (default: the whole '
                            'tree below --base); the payload is fixed to it '
@@ -122,10 +120,9 @@ def register(subparsers):
                      help='the link the payload is fixed to; com and '
                           'inertia in its frame (default: the tip; needed '
                           'on a tree with several tips)')
-    pay.add_argument('--json', action='store_true',
-                     help="print the node's payload.* parameters as JSON "
-                          '(null where the motion does not determine a '
-                          'value; "undetermined" says why)')
+    json_option(pay, "print the node's payload.* parameters as JSON (null "
+                     'where the motion does not determine a value; '
+                     '"undetermined" says why)')
     pay.set_defaults(func=_one_line_exit_2(cmd_payload))
 
 

@@ -45,7 +45,8 @@ import tempfile
 
 import numpy as np
 
-from .cli_options import chain_options, robot_argument, topic_option
+from .cli_options import (chain_options, json_option, robot_argument,
+                          topic_option)
 
 WRENCH_COLUMNS = ('fx', 'fy', 'fz', 'mx', 'my', 'mz')
 
@@ -67,10 +68,9 @@ def register(subparsers):
                        'the single leaf)')
     obs.add_argument('--csv', metavar='OUT.csv',
                      help='write one row per sample here')
-    obs.add_argument('--json', action='store_true',
-                     help='print the summary as one JSON object (with '
-                          'suggested_thresholds, one per joint in chain '
-                          'order) instead of a table')
+    json_option(obs, 'print the summary as one JSON object (with '
+                     'suggested_thresholds, one per joint in chain order) '
+                     'instead of a table')
     obs.add_argument('--plot', metavar='OUT.png',
                      help='also plot external torques and wrench')
     topic_option(obs)

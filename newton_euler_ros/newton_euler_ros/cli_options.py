@@ -15,12 +15,14 @@
 """
 Argument groups that several ``newton-euler`` commands share.
 
-One definition each for the robot argument, the chain options of a
-command that also takes a robot YAML, the chain and recording options
-of the commands that read a recording (identify, replay, payload) and
-the JointState topic, so that the same option reads the same in every
-command's ``--help``.  Imports nothing heavy: ``cli`` builds its parser
-from these before any command runs.
+One definition each for the robot argument, the URDF argument of the
+commands that take only a URDF, the chain options of a command that
+also takes a robot YAML, the chain and recording options of the
+commands that read a recording (identify, replay, payload), the
+JointState topic, and the --json and --overwrite switches, so that the
+same option reads the same in every command's ``--help``.  Imports
+nothing heavy: ``cli`` builds its parser from these before any command
+runs.
 """
 ROBOT_HELP = 'robot YAML or URDF file, or bundled robot name'
 TOPIC_HELP = 'JointState topic (default /joint_states)'
@@ -29,6 +31,11 @@ TOPIC_HELP = 'JointState topic (default /joint_states)'
 def robot_argument(parser):
     """Add the positional ROBOT: a file or a bundled robot's name."""
     parser.add_argument('robot', metavar='ROBOT', help=ROBOT_HELP)
+
+
+def model_argument(parser, model_help):
+    """Add the positional MODEL.urdf (``args.model``): ``model_help``."""
+    parser.add_argument('model', metavar='MODEL.urdf', help=model_help)
 
 
 def chain_options(parser, tip_help):
@@ -59,3 +66,14 @@ def recording_options(parser, tip_help, cutoff_help):
     topic_option(parser)
     parser.add_argument('--cutoff', type=float, metavar='HZ',
                         help=cutoff_help)
+
+
+def json_option(parser, json_help):
+    """Add --json: print the result as JSON (``json_help``: what)."""
+    parser.add_argument('--json', action='store_true', help=json_help)
+
+
+def overwrite_option(parser, overwrite_help):
+    """Add --overwrite: write over an existing file (``overwrite_help``)."""
+    parser.add_argument('--overwrite', action='store_true',
+                        help=overwrite_help)
