@@ -25,9 +25,10 @@ SHELL := /bin/bash
 VENV := .venv
 PY   := $(VENV)/bin/python
 PYTEST_ARGS ?=
-# Two test processes, one test file each at a time (pytest-xdist): the node
+# Two test processes, one test file each at a time (pytest-xdist), in the
+# order conftest.py gives (the longest files first): the node
 # tests mostly wait on DDS; make test PYTEST_WORKERS= runs them in one.
-PYTEST_WORKERS ?= -n 2 --dist loadfile
+PYTEST_WORKERS ?= -n 2 --dist loadfile --no-loadscope-reorder
 
 # Tests must not see (or be seen by) ROS 2 nodes on other hosts; override on
 # the command line only if you mean it (make test ROS_AUTOMATIC_DISCOVERY_RANGE=SUBNET).
