@@ -14,9 +14,6 @@
 
 """Effort feedforward along trajectories: library and CLI."""
 import json
-import os
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import (DynamicsInputError, inverse_dynamics,
@@ -25,6 +22,7 @@ from newton_euler_ros.core.trajectory import (differentiate, fill_efforts,
                                               trajectory_efforts)
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 
 @pytest.fixture(scope='module')
@@ -150,10 +148,7 @@ def test_fill_efforts_keeps_the_object(puma):
 
 
 def run_cli(*args):
-    proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
-                           *args], capture_output=True, text=True,
-                          timeout=120, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def test_cli_feedforward(tmp_path, puma):

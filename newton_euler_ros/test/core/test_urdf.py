@@ -27,7 +27,6 @@ URDF robots, checked against references that do not use our loader.
 """
 import json
 import math
-import os
 import subprocess
 import sys
 import warnings
@@ -44,6 +43,7 @@ from newton_euler_ros.core.urdf import (inspect_urdf, load_urdf, matrix_rpy,
 import numpy as np
 import pytest
 import reference_dynamics as ref
+from cli_harness import newton_euler  # noqa: E402, I100
 
 EPS = np.finfo(float).eps
 
@@ -710,10 +710,7 @@ def test_mistyped_links_name_the_closest():
 # the CLI on URDF
 # ---------------------------------------------------------------------------
 def run_cli(*args):
-    proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
-                           *args], capture_output=True, text=True,
-                          timeout=120, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def test_cli_dynamics_on_urdf_prints_the_dh_json(tmp_path):

@@ -12,11 +12,9 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""``newton-euler identify`` and ``replay`` as real processes."""
+"""``newton-euler identify`` and ``replay`` (in the test process: cli_harness)."""
 import csv
 import shutil
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import (inverse_dynamics_batch, load_robot,
@@ -28,15 +26,13 @@ from newton_euler_tools.ident_example import (BASE, make_example,
                                               panda_path, TIP)
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 CHAIN = ['--base', BASE, '--tip', TIP]
 
 
 def run(*args, cwd=None):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)],
-        capture_output=True, text=True, cwd=cwd, timeout=300)
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args, cwd=cwd)
 
 
 def one_line_error(err, *names):

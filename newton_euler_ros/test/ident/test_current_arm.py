@@ -33,8 +33,6 @@ constants within 2.1 %).
 import json
 import os
 import re
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import load_robot
@@ -45,6 +43,7 @@ from newton_euler_tools import current_arm_example as arm_example
 from newton_euler_tools.current_arm_example import BASE, JOINTS, TIP
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 CHAIN = ['--base', BASE, '--tip', TIP]
 # joints whose axes stay horizontal on a UR: gravity always loads them
@@ -52,10 +51,7 @@ GRAVITY_LOADED = (1, 2, 3)
 
 
 def run(*args):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)],
-        capture_output=True, text=True, timeout=300)
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def one_line_error(err, *words):

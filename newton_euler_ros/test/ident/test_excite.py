@@ -14,9 +14,6 @@
 
 """Excitation trajectories: limits, rest at both ends, conditioning."""
 import json
-import os
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import load_robot
@@ -28,16 +25,14 @@ from newton_euler_ros.ident.excite import (ExcitationError, excite, MARGIN,
 from newton_euler_tools.ident_example import BASE, panda_path, TIP
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 # the Panda's ready pose: where excite starts (the arm's pose now)
 START = ['--start', '0', '-0.785', '0', '-2.356', '0', '1.571', '0.785']
 
 
 def run_cli(*args):
-    proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
-                           *args], capture_output=True, text=True,
-                          timeout=300, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 @pytest.fixture(scope='module')

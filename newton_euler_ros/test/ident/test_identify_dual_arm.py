@@ -26,9 +26,6 @@ head and the grippers move at once.  ``newton-euler identify`` without
 recording; ``replay`` on another recording, with stops, measures it.
 """
 import json
-import os
-import subprocess
-import sys
 import warnings
 import xml.etree.ElementTree as ET
 
@@ -42,6 +39,7 @@ from newton_euler_tools.dual_arm_example import (BASE, EXTRA, KNOWN_MASS,
                                                  TOOL_LINK)
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 ARMS = [f'{side}_{j}' for side in ('right', 'left')
         for j in ('s0', 's1', 'e0', 'e1', 'w0', 'w1', 'w2')]
@@ -49,10 +47,7 @@ FINGERS = ['r_gripper_l_finger_joint', 'l_gripper_l_finger_joint']
 
 
 def run(*args):
-    exe = os.path.join(os.path.dirname(sys.executable), 'newton-euler')
-    proc = subprocess.run([exe, *map(str, args)], capture_output=True,
-                          text=True, timeout=600)
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def table(stdout, title):

@@ -22,8 +22,6 @@ Recordings: ``newton_euler_tools.ident_example`` (a "real" Panda with
 torque sensors) and ``current_arm_example`` (a UR-like arm with stick-slip
 friction, here with torque efforts).
 """
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import load_robot, RobotFileError
@@ -36,15 +34,13 @@ from newton_euler_tools import current_arm_example as arm_example
 from newton_euler_tools.ident_example import BASE, make_example, TIP
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 CHAIN = ['--base', BASE, '--tip', TIP]
 
 
 def run(*args):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)],
-        capture_output=True, text=True, timeout=300)
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def quiet_load(path, base=BASE, tip=TIP):

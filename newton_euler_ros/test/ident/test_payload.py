@@ -22,10 +22,7 @@ plus friction, offsets, rotor inertia and noise, lost messages, stamp
 jitter and the fingers in the message.
 """
 import json
-import os
 import shutil
-import subprocess
-import sys
 import warnings
 
 from newton_euler_ros.core import load_robot
@@ -36,13 +33,11 @@ from newton_euler_tools.ident_example import BASE, TIP
 from newton_euler_tools.payload_example import make_example
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 
 def run_cli(*args):
-    proc = subprocess.run([sys.executable, '-m', 'newton_euler_ros.cli',
-                           *map(str, args)], capture_output=True, text=True,
-                          timeout=300, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 def payload_cli(paths, *extra):

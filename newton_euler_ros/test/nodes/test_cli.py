@@ -12,7 +12,7 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""The newton-euler command, run as a real process."""
+"""The newton-euler command (in the test process: cli_harness), and its cache."""
 import json
 import os
 import subprocess
@@ -20,17 +20,14 @@ import sys
 
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 PUMA_Q = ['0', '0.5', '-0.3', '0.1', '0.2', '0.3']
 PUMA_QD = ['0.1', '0.2', '0.3', '0.4', '0.5', '0.6']
 
 
 def run(*args, cwd=None):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', *args],
-        capture_output=True, text=True, timeout=120, cwd=cwd,
-        env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args, cwd=cwd)
 
 
 def test_json_terms_satisfy_the_equation_of_motion():

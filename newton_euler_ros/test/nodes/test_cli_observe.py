@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-``newton-euler observe`` as a real process, on a real bag.
+``newton-euler observe`` in the test process (cli_harness), on a real bag.
 
 The bag is written by rosbags' Writer (``ident.bag.write_joint_states``);
 its efforts come from the Euler-Lagrange oracle for a Puma 560 URDF that
@@ -37,6 +37,7 @@ from newton_euler_ros.ident.bag_write import write_joint_states
 import numpy as np
 import pytest
 import reference_dynamics as ref
+from cli_harness import newton_euler  # noqa: E402, I100
 
 pytest.importorskip('rosbags')
 
@@ -46,10 +47,7 @@ T_ON, T_OFF = 1.0, 2.0
 
 
 def run(*args):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', 'observe', *args],
-        capture_output=True, text=True, timeout=180, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler('observe', *args)
 
 
 def motion(t, n):

@@ -23,15 +23,13 @@ its efforts in amperes and (times its torque constants) in N m, against
 the published UR5 URDF (no constants).
 """
 import json
-import os
-import subprocess
-import sys
 
 from newton_euler_ros.ident.bag import read_joint_states
 from newton_euler_ros.ident.bag_write import write_joint_states
 from newton_euler_tools import current_arm_example as arm_example
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 pytest.importorskip('rosbags')
 
@@ -39,11 +37,7 @@ CHAIN = ['--base', arm_example.BASE, '--tip', arm_example.TIP]
 
 
 def run(*args):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', 'observe',
-         *map(str, args), *CHAIN], capture_output=True, text=True,
-        timeout=180, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler('observe', *args, *CHAIN)
 
 
 @pytest.fixture(scope='module')

@@ -13,7 +13,7 @@
 # limitations under the License.
 
 """
-newton-euler on a whole robot (a URDF without --tip), as a real process.
+newton-euler on a whole robot (a URDF without --tip), in the test process (cli_harness).
 
 Baxter from example-robot-data (two arms, a head, a mimic finger in
 each gripper): ``dynamics`` against Pinocchio's reading of the same URDF
@@ -23,13 +23,11 @@ Jacobian, ``check``'s tree against the URDF's own parent links,
 whose robot is the whole tree.
 """
 import json
-import os
-import subprocess
-import sys
 import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
+from cli_harness import newton_euler  # noqa: E402, I100
 
 BAXTER = 'baxter_description/urdf/baxter.urdf'
 LEFT = ['left_s0', 'left_s1', 'left_e0', 'left_e1', 'left_w0', 'left_w1',
@@ -37,10 +35,7 @@ LEFT = ['left_s0', 'left_s1', 'left_e0', 'left_e1', 'left_w0', 'left_w1',
 
 
 def run(*args):
-    proc = subprocess.run(
-        [sys.executable, '-m', 'newton_euler_ros.cli', *map(str, args)],
-        capture_output=True, text=True, timeout=120, env=dict(os.environ))
-    return proc.returncode, proc.stdout, proc.stderr
+    return newton_euler(*args)
 
 
 @pytest.fixture(scope='module')
