@@ -188,7 +188,8 @@ def main(argv=None):
     if '--force' not in argv and os.path.exists(stamp):
         return 0
     print("[precompile] compiling the kernels into numba's cache "
-          '(once per install: a minute or two on 2 cores)', flush=True)
+          '(once per change of their sources: about 10 min on 2 cores)',
+          flush=True)
     seconds = precompile()
     os.makedirs(os.path.dirname(stamp), exist_ok=True)
     with open(stamp, 'w', encoding='utf-8') as fh:
