@@ -24,9 +24,20 @@ The composite-rigid-body D(q) and the genuine float32 path.
   and the errors of :class:`Float32Dynamics` against the 50-digit
   reference are those of float32: well above float64 round-off, below
   100 n eps32.
+
+The type-map check compiles every kernel afresh (numba's disk cache holds
+no type maps): about two minutes.  Its verdict depends only on the
+kernels' sources, this file, numba and Python, so a pass is recorded
+under their digest beside numba's cache (``...-verdicts``) and the next
+run with the same four reads the record instead of compiling again; any
+change to one of them runs the check in full.  ``NEWTON_EULER_RECHECK=1``
+runs it in full regardless.
 """
 import doctest
+import hashlib
 import math
+import os
+import sys
 import warnings
 
 import mpmath
@@ -343,12 +354,32 @@ def _tree_with_mimic():
                                           None])
 
 
-@pytest.fixture(scope='module')
-def fresh_kernels():
-    return _fresh_kernels()
+def _verdict_file():
+    """
+    Return the file recording a pass of the type-map check, by digest.
+
+    Of the kernels' sources (numba's cache key for them), this test file,
+    numba's version and Python's.
+    """
+    digest = hashlib.sha256()
+    digest.update(K._jit.package_stamp().encode())
+    with open(__file__, 'rb') as fh:
+        digest.update(fh.read())
+    digest.update(f'{numba.__version__}\0{sys.version}'.encode())
+    base = os.environ.get('NUMBA_CACHE_DIR') or os.path.join(
+        os.environ.get('XDG_CACHE_HOME') or os.path.expanduser('~/.cache'),
+        'newton_euler_ros', 'numba')
+    return os.path.join(base.rstrip(os.sep) + '-verdicts',
+                        f'float32-type-maps-{digest.hexdigest()[:32]}')
 
 
-def test_float32_kernels_have_no_float64_anywhere(fresh_kernels):
+def test_float32_kernels_have_no_float64_anywhere():
+    verdict = _verdict_file()
+    if os.path.exists(verdict) and os.environ.get(
+            'NEWTON_EULER_RECHECK') != '1':
+        print(f'passed before on these sources: {verdict}')
+        return
+    fresh_kernels = _fresh_kernels()
     # a chain with both joint types in both conventions covers every branch
     for convention in ('standard', 'modified'):
         _run_every_kernel(fresh_kernels, _chain(4, 1, convention),
@@ -358,9 +389,12 @@ def test_float32_kernels_have_no_float64_anywhere(fresh_kernels):
     found, missing = _float64_variables(fresh_kernels)
     assert not missing, f'kernels never compiled for float32: {missing}'
     assert not found, found
+    os.makedirs(os.path.dirname(verdict), exist_ok=True)
+    with open(verdict, 'w', encoding='utf-8') as fh:
+        fh.write('no float64 in the float32 type maps of every kernel\n')
 
 
-def test_type_map_check_sees_float64(fresh_kernels):
+def test_type_map_check_sees_float64():
     """The check flags a float literal mixed into float32 arithmetic."""
     @numba.njit
     def leaky(x):
