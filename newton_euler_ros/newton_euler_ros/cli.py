@@ -59,12 +59,12 @@ from .cli_report import (format_table, mass_counted,  # noqa: E402
                          source, tree_lines, types_of)
 from .cli_ros import (register as register_ros, RosCliError,  # noqa: E402
                       RosGraphError)
-from .core import (coriolis_matrix, gravity_torques,  # noqa: E402
-                   inspect_robot, inverse_dynamics, jacobian, mass_matrix,
-                   NewtonEulerError, RobotFileError)
+# only what every start needs: the dynamics, numba and the kernels load
+# where a command first uses them, so --help and usage errors skip them
 from .core.drives import describe_drives, model_drives  # noqa: E402
-from .core.robot_file import (bundled_robots, Note, read_text,  # noqa: E402
-                              to_number)
+from .core.errors import NewtonEulerError, RobotFileError  # noqa: E402
+from .core.inertia import Note  # noqa: E402
+from .core.text import read_text  # noqa: E402
 
 # the exit statuses of every command (docs/cli.md states the rule)
 EXIT_DONE = 0
@@ -95,6 +95,7 @@ def _read_json(path):
 
 
 def _numbers(values, option):
+    from .core.robot_file import to_number
     try:
         return [to_number(v, option) for v in values]
     except NewtonEulerError as exc:     # a malformed argument: usage
@@ -135,6 +136,8 @@ def evaluate(model, q, qd, qdd, wrench, wrench_frame, link=None):
     ``jacobian`` is the end effector's, or ``link``'s; None for a tree
     with several tips and no ``link``.
     """
+    from .core.dynamics import (coriolis_matrix, gravity_torques,
+                                inverse_dynamics, jacobian, mass_matrix)
     w, frame = _at_link(model, wrench, wrench_frame, link)
     if link is not None:
         J = jacobian(model, q, link, axes=frame[link])
@@ -189,6 +192,7 @@ def _warn(found):
 
 
 def _load(args):
+    from .core.robot_file import inspect_robot
     try:
         return inspect_robot(args.robot, base=args.base, tip=args.tip)
     except RobotFileError as exc:
@@ -395,6 +399,7 @@ def _wrench_options(parser, wrench_help, frame_help):
 
 
 def cmd_robots(_args):
+    from .core.robot_file import bundled_robots
     for name in bundled_robots():
         print(name)
     return 0

@@ -23,29 +23,55 @@ of ``D(q) qdd + C(q, qd) qd + g(q) + J(q)^T F_e = tau``,
 and rotor inertia, and :mod:`newton_euler_ros.core.observer` for the
 momentum observer.
 """
-from .derivatives import (forward_dynamics_derivatives,
-                          forward_dynamics_derivatives_batch,
-                          inverse_dynamics_derivatives,
-                          inverse_dynamics_derivatives_batch)
-from .drives import Drives
-from .dynamics import (coriolis_matrix, coriolis_matrix_batch,
-                       end_effector_pose, forward_dynamics,
-                       forward_dynamics_batch, frame_pose, gravity_torques,
-                       gravity_torques_batch, inverse_dynamics,
-                       inverse_dynamics_batch, jacobian, link_poses,
-                       mass_matrix, mass_matrix_batch, mass_matrix_condition,
-                       velocity_products, wrench_torques)
-from .effects import EffectDynamics, Effects
-from .errors import (DynamicsInputError, NewtonEulerError,
-                     NotPositiveDefiniteError, RobotFileError)
-from .float32 import Float32Dynamics
-from .model import make_model, pose_matrix, RobotModel, rpy_matrix
-from .observer import MomentumObserver, observe_recording
-from .regressor import regressor, regressor_batch
-from .robot_file import (bundled_robots, inspect_robot, load_robot,
-                         robot_from_dict, RobotFileWarning)
-from .urdf import load_urdf, model_to_urdf
-from .workspace import Workspace
+import importlib
+
+# where each name of the package's API lives: imported on first use
+# (PEP 562), so that a program reading only, say, ``core.errors`` or
+# ``core.text`` (the CLI's --help and its usage errors) does not load
+# numba and the kernels
+_WHERE = {
+    'forward_dynamics_derivatives': 'derivatives',
+    'forward_dynamics_derivatives_batch': 'derivatives',
+    'inverse_dynamics_derivatives': 'derivatives',
+    'inverse_dynamics_derivatives_batch': 'derivatives',
+    'Drives': 'drives',
+    'EffectDynamics': 'effects', 'Effects': 'effects',
+    'DynamicsInputError': 'errors', 'NewtonEulerError': 'errors',
+    'NotPositiveDefiniteError': 'errors', 'RobotFileError': 'errors',
+    'Float32Dynamics': 'float32',
+    'make_model': 'model', 'pose_matrix': 'model', 'RobotModel': 'model',
+    'rpy_matrix': 'model',
+    'MomentumObserver': 'observer', 'observe_recording': 'observer',
+    'regressor': 'regressor', 'regressor_batch': 'regressor',
+    'bundled_robots': 'robot_file', 'inspect_robot': 'robot_file',
+    'load_robot': 'robot_file', 'robot_from_dict': 'robot_file',
+    'RobotFileWarning': 'errors',
+    'load_urdf': 'urdf', 'model_to_urdf': 'urdf',
+    'Workspace': 'workspace',
+}
+_WHERE.update(dict.fromkeys((
+    'coriolis_matrix', 'coriolis_matrix_batch', 'end_effector_pose',
+    'forward_dynamics', 'forward_dynamics_batch', 'frame_pose',
+    'gravity_torques', 'gravity_torques_batch', 'inverse_dynamics',
+    'inverse_dynamics_batch', 'jacobian', 'link_poses', 'mass_matrix',
+    'mass_matrix_batch', 'mass_matrix_condition', 'velocity_products',
+    'wrench_torques'), 'dynamics'))
+
+
+def __getattr__(name):
+    """Import the module of one of the package's names on its first use."""
+    where = _WHERE.get(name)
+    if where is None:
+        raise AttributeError(
+            f'module {__name__!r} has no attribute {name!r}')
+    value = getattr(importlib.import_module(f'.{where}', __name__), name)
+    globals()[name] = value     # the next use is a plain lookup
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_WHERE))
+
 
 __all__ = [
     'Drives', 'DynamicsInputError', 'EffectDynamics', 'Effects',

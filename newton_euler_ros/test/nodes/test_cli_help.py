@@ -154,3 +154,65 @@ def test_node_help_names_its_page_and_the_page_exists(node):
     assert 'README ("' not in text           # a section that is gone
     with open(os.path.join(ROOT, NODE_PAGES[node]), encoding='utf-8') as fh:
         assert markdown_table(load_specs(node)) in fh.read()
+
+
+def test_help_and_usage_errors_load_no_dynamics():
+    """
+    ``--help`` and a usage error answer without numba or the kernels.
+
+    They are what a user types first and most often: the dynamics load
+    where a command first uses them (1.4 s of a 1.7 s ``--help`` before).
+    """
+    code = '\n'.join((
+        'import contextlib, io, sys',
+        'from newton_euler_ros import cli',
+        'for argv in sys.argv[1:]:',
+        '    out = io.StringIO()',
+        '    with contextlib.redirect_stdout(out), '
+        'contextlib.redirect_stderr(out):',
+        '        try:',
+        '            status = cli.main(argv.split())',
+        '        except SystemExit as exc:',
+        '            status = exc.code',
+        '    print(argv, status, out.getvalue().count("\\n"))',
+        'loaded = sorted(m for m in sys.modules if m == "numba" or',
+        '                m.startswith("newton_euler_ros.core.kernels"))',
+        'print("loaded:", loaded)'))
+    argvs = ['--help', 'frobnicate'] + [f'{c} --help' for c in COMMANDS] \
+        + ['dynamics', 'identify', 'observe a b --rate x']
+    proc = subprocess.run([sys.executable, '-c', code, *argvs],
+                          capture_output=True, text=True, timeout=120)
+    lines = proc.stdout.splitlines()
+    assert proc.returncode == 0 and lines[-1] == 'loaded: []', (
+        proc.stdout[-2000:] + proc.stderr[-2000:])
+    statuses = dict(line.rsplit(' ', 2)[:2] for line in lines[:-1])
+    assert statuses['--help'] == '0' and statuses['identify --help'] == '0'
+    assert statuses['frobnicate'] == '2' and statuses['identify'] == '2'
+    assert statuses['dynamics'] == '2', statuses
+    assert statuses['observe a b --rate x'] == '2', statuses
+
+
+def test_the_core_names_load_on_first_use():
+    """Every name of ``core.__all__`` resolves; reading errors loads none."""
+    code = '\n'.join((
+        'import sys',
+        'import newton_euler_ros.core as core',
+        'from newton_euler_ros.core import NewtonEulerError',
+        'assert "numba" not in sys.modules, "errors alone loaded numba"',
+        'assert sorted(core.__all__) == sorted(core._WHERE), "__all__"',
+        'for name in core.__all__:',
+        '    value = getattr(core, name)',
+        '    assert getattr(value, "__name__", name) == name, name',
+        'assert set(core.__all__) <= set(dir(core))',
+        'try:',
+        '    core.no_such_name',
+        'except AttributeError as exc:',
+        '    print(exc)',
+        'from newton_euler_ros.core import *',
+        'print(inverse_dynamics.__module__)'))
+    proc = subprocess.run([sys.executable, '-c', code], capture_output=True,
+                          text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.splitlines() == [
+        "module 'newton_euler_ros.core' has no attribute 'no_such_name'",
+        'newton_euler_ros.core.dynamics'], proc.stdout
