@@ -73,9 +73,9 @@ def _coordinates(frames):
 def inverse_dynamics_row(links, frames, q, qd, qdd, wrench, flags, ws, tau):
     """tau(q, qd, qdd, F_e); ``flags`` selects gravity, velocity, wrench."""
     joint_trig(links, frames, q, ws)
-    recursion(links, frames, qd, qd, qdd, wrench, ws, (flags & GRAVITY) != 0,
-              (flags & VELOCITY) != 0, (flags >> WRENCH_SHIFT) & WRENCH_BITS,
-              False, ws, tau)
+    recursion(links, frames, qd, qd, qdd, wrench, None,
+              (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
+              (flags >> WRENCH_SHIFT) & WRENCH_BITS, False, ws, tau)
     if first_nonfinite(tau) >= 0:
         return OVERFLOW
     return -1

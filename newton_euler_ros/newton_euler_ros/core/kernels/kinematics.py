@@ -90,6 +90,19 @@ def joint_rate(links, x, j, mimic):
 
 
 @njit(cache=True, inline='always')
+def rate_or_zero(links, frames, x, j, mimic):
+    """
+    Return :func:`joint_rate` of ``x``, or zero when ``x`` is None.
+
+    A caller passing None (no velocity, no acceleration) gets code that
+    reads nothing: numba compiles the branch for None alone.
+    """
+    if x is None:
+        return frames[F_CONST, C_ZERO]
+    return joint_rate(links, x, j, mimic)
+
+
+@njit(cache=True, inline='always')
 def put(links, out, j, x, mimic):
     """Put x, what body j's joint takes, into its coordinate of ``out``."""
     if mimic:

@@ -22,7 +22,8 @@ to base, balances forces and moments link by link and reads each joint's
 torque off its axis.  :func:`tip_wrench` is the backward pass's starting
 value, the wrench the end effector exerts.  g(q) (:func:`gravity`) and
 the column-by-column D and C (:func:`unit_columns`) are this recursion
-with some inputs zero.
+with some inputs zero: those pass ``None``, which numba compiles away
+(a separate specialisation reads no such argument at all).
 
 Notation (all vectors of link j are expressed in kernel frame j, whose z
 axis is the axis of joint j through its origin O_j; see
@@ -56,7 +57,8 @@ differentiating ``w x r`` while r grows at the rate ``z qd``.
 from ._jit import njit
 from .kinematics import (branch_point, frame_rotation, has_mimic, joint_rate,
                          joint_trig, link_inertia, parent, placement, put,
-                         revolute, stored_placement, tool_body, zero_matrix)
+                         rate_or_zero, revolute, stored_placement, tool_body,
+                         zero_matrix)
 from .layout import (C_HALF, C_ONE, C_ZERO, CW_V, F_CONST, F_GRAV, F_TOOL,
                      L_BODY, L_COM, L_MASS, W_ACC, W_F, W_N, W_X,
                      WRENCH_BASE, WRENCH_NONE)
@@ -96,18 +98,19 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
     frames : (F_ROWS, 12) array
         Base frame, tool frame, gravity, constants and the tree's shape
         (the ``F_*`` rows).
-    qd, v, qdd : (n,) arrays
+    qd, v, qdd : (n,) arrays or None
         Joint velocity, reference velocity, acceleration (coordinates: a
-        mimic joint moves with its lead).
-    wrench : (6,) array
+        mimic joint moves with its lead); None is zero.  qd and v are
+        read only with ``velocity_on``.
+    wrench : (6,) array or None
         [f; n] exerted by the end effector on its environment, moment about
         the end-effector origin; base-frame axes when
         ``wrench_mode == WRENCH_BASE``, end-effector axes when
-        ``WRENCH_EE``; ignored when ``WRENCH_NONE``.
-    fext : (nb, 6) array
+        ``WRENCH_EE``; ignored when ``WRENCH_NONE``.  None: no wrench.
+    fext : (nb, 6) array or None
         With ``link_wrenches``: row j is [f; n] exerted by link j on its
         environment, in link j's axes, the moment about its origin
-        (several links at once); ignored otherwise.
+        (several links at once); ignored otherwise.  None: none.
     gravity_on, velocity_on : bool
         Skip the gravity or velocity-product terms altogether when False.
     wrench_mode : int
@@ -168,7 +171,7 @@ def forward_pass(links, frames, qd, v, qdd, gravity_on, velocity_on, ws):
                 al = load3(ws, par, W_X + 6)
                 ae = load3(ws, par, W_X + 9)
         R, p = placement(links, frames, j, ws)
-        qddj = joint_rate(links, qdd, j, mimic)
+        qddj = rate_or_zero(links, frames, qdd, j, mimic)
         # acceleration of the new origin O_j, still in the parent's axes
         t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
         ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
@@ -181,9 +184,9 @@ def forward_pass(links, frames, qd, v, qdd, gravity_on, velocity_on, ws):
         al = rot_t(R, al[0], al[1], al[2])
         is_revolute = revolute(links, frames, j)
         if velocity_on:
-            # qd and v are read only here: gravity passes none
-            qdj = joint_rate(links, qd, j, mimic)
-            vj = joint_rate(links, v, j, mimic)
+            # qd and v are read only here
+            qdj = rate_or_zero(links, frames, qd, j, mimic)
+            vj = rate_or_zero(links, frames, v, j, mimic)
             w = rot_t(R, w[0], w[1], w[2])
             r = rot_t(R, r[0], r[1], r[2])
             if is_revolute:
@@ -276,15 +279,17 @@ def backward_pass(links, frames, wrench, wrench_mode, fext, link_wrenches,
                  f[2] + ws[j, W_ACC + 2])
             nm = (nm[0] + ws[j, W_ACC + 3], nm[1] + ws[j, W_ACC + 4],
                   nm[2] + ws[j, W_ACC + 5])
-        if j == tool:
-            e = tip_wrench(frames, wrench, wrench_mode,
-                           frame_rotation(links, frames, ws, j))
-            nm = (nm[0] + e[0], nm[1] + e[1], nm[2] + e[2])
-            f = (f[0] + e[3], f[1] + e[4], f[2] + e[5])
-        if link_wrenches:
-            fe, ne = link_wrench(links, fext, j)
-            f = (f[0] + fe[0], f[1] + fe[1], f[2] + fe[2])
-            nm = (nm[0] + ne[0], nm[1] + ne[1], nm[2] + ne[2])
+        if wrench is not None:      # (compiled away when None)
+            if j == tool:
+                e = tip_wrench(frames, wrench, wrench_mode,
+                               frame_rotation(links, frames, ws, j))
+                nm = (nm[0] + e[0], nm[1] + e[1], nm[2] + e[2])
+                f = (f[0] + e[3], f[1] + e[4], f[2] + e[5])
+        if fext is not None:
+            if link_wrenches:
+                fe, ne = link_wrench(links, fext, j)
+                f = (f[0] + fe[0], f[1] + fe[1], f[2] + fe[2])
+                nm = (nm[0] + ne[0], nm[1] + ne[1], nm[2] + ne[2])
         F0 = ws[j, W_F]
         F1 = ws[j, W_F + 1]
         F2 = ws[j, W_F + 2]
@@ -357,17 +362,10 @@ def tip_wrench(frames, wrench, wrench_mode, Racc):
 @njit(cache=True, inline='always')
 def gravity(links, frames, q, ws, tau):
     """g(q) into tau: the recursion at rest with gravity only."""
-    # tau, zeroed, serves as qdd (and as the velocities, which the
-    # recursion does not read with velocity_on False): the forward pass
-    # reads it before the backward pass writes the torques into it.  The
-    # wrench (6,) and the link wrenches (the workspace) are not read
-    # either (WRENCH_NONE, no link wrenches); every argument has its
-    # declared size all the same, so bounds checking finds nothing.
     joint_trig(links, frames, q, ws)
-    for j in range(tau.shape[0]):
-        tau[j] = frames[F_CONST, C_ZERO]
-    recursion(links, frames, tau, tau, tau, frames[0, :6], ws, True, False,
-              WRENCH_NONE, False, ws, tau)
+    # no velocities, no acceleration but gravity's, no wrenches
+    forward_pass(links, frames, None, None, None, True, False, ws)
+    backward_pass(links, frames, None, WRENCH_NONE, None, False, ws, tau)
 
 
 @njit(cache=True)
@@ -376,23 +374,22 @@ def unit_columns(links, frames, qd, coriolis, ws, scratch, M):
     Columns of D (``coriolis`` False) or C(q, qd) from unit inputs.
 
     D e_k = Y(q, 0, 0, e_k) and C e_k = Y(q, qd, e_k, 0), where Y is the
-    two-stream recursion; ``joint_trig`` must have been called for q.
-    ``scratch`` is a (3, n) array.  Cost: n recursions, O(n nb).
+    two-stream recursion (the zeros pass as None); ``joint_trig`` must
+    have been called for q.  ``scratch`` is a (3, n) array (rows 1 and 2
+    used).  Cost: n recursions, O(n nb).
     """
     n = M.shape[0]
-    zero = scratch[0]
     unit = scratch[1]
     col = scratch[2]
     for i in range(n):
-        zero[i] = frames[F_CONST, C_ZERO]
         unit[i] = frames[F_CONST, C_ZERO]
     for k in range(n):
         unit[k] = frames[F_CONST, C_ONE]
         if coriolis:
-            recursion(links, frames, qd, unit, zero, zero, ws, False, True,
+            recursion(links, frames, qd, unit, None, None, None, False, True,
                       WRENCH_NONE, False, ws, col)
         else:
-            recursion(links, frames, zero, zero, unit, zero, ws, False,
+            recursion(links, frames, None, None, unit, None, None, False,
                       False, WRENCH_NONE, False, ws, col)
         unit[k] = frames[F_CONST, C_ZERO]
         for i in range(n):
