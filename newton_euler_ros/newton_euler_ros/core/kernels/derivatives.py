@@ -126,7 +126,8 @@ def derivative_forward(links, frames, qd, qdd, wrench, fext, wext, gravity_on,
     the rows ``fext`` (fixed to the link, its axes about its origin, as
     the recursion takes them) and ``wext`` (fixed direction: each row
     the 15 numbers ``add_direction_wrench`` adds, summed over the link's
-    wrenches; see ``core.frames.derivative_wrench_rows``).
+    wrenches; see ``core.frames.derivative_wrench_rows``).  ``fext`` and
+    ``wext`` are both arrays or both None (no wrenches at links).
     """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
@@ -175,14 +176,15 @@ def derivative_forward(links, frames, qd, qdd, wrench, fext, wext, gravity_on,
                         frames[F_TOOL, 11])
                 p = (ow[0] + t[0], ow[1] + t[1], ow[2] + t[2])
                 add_direction_wrench(dw, j, n, f, p)
-        if link_wrenches:
-            fe, ne = link_wrench(links, fext, j)
-            add_fixed_wrench(dw, j, Rw, ow,
-                             (ne[0], ne[1], ne[2], fe[0], fe[1], fe[2]))
-            for k in range(6):
-                dw[j, DW_E + k] += wext[j, k]
-            for k in range(15):
-                dw[j, DW_W + k] += wext[j, k]
+        if fext is not None:        # (compiled away when None)
+            if link_wrenches:
+                fe, ne = link_wrench(links, fext, j)
+                add_fixed_wrench(dw, j, Rw, ow,
+                                 (ne[0], ne[1], ne[2], fe[0], fe[1], fe[2]))
+                for k in range(6):
+                    dw[j, DW_E + k] += wext[j, k]
+                for k in range(15):
+                    dw[j, DW_W + k] += wext[j, k]
 
 
 @njit(cache=True, inline='always')

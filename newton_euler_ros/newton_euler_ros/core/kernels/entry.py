@@ -194,7 +194,7 @@ def regressor_row(links, frames, q, qd, qdd, drives, eps, ws, line, acc, Y):
 def inverse_dynamics_derivatives_row(links, frames, q, qd, qdd, wrench,
                                      damping, flags, ws, cw, dw, dtau):
     """dtau/dq, dtau/dqd into dtau[0], dtau[1] (``rnea_derivatives``)."""
-    return rnea_derivatives(links, frames, q, qd, qdd, wrench, dw, dw,
+    return rnea_derivatives(links, frames, q, qd, qdd, wrench, None, None,
                             (flags & GRAVITY) != 0,
                             (flags >> WRENCH_SHIFT) & WRENCH_BITS, False,
                             damping, ws, cw, dw, dtau[0], dtau[1])
@@ -217,7 +217,8 @@ def forward_dynamics_derivatives_row(links, frames, q, qd, tau, wrench,
                                      armature, damping, flags, ws, cw, dw,
                                      chol, scratch, dqdd):
     """dqdd/dq, dqdd/dqd, dqdd/dtau into dqdd[0..2] (``aba_derivatives``)."""
-    return aba_derivatives(links, frames, q, qd, tau, wrench, dw, dw, dw,
+    return aba_derivatives(links, frames, q, qd, tau, wrench, None, None,
+                           None,
                            (flags & GRAVITY) != 0,
                            (flags >> WRENCH_SHIFT) & WRENCH_BITS, False,
                            armature, damping, ws, cw, dw, chol, scratch,
