@@ -87,6 +87,9 @@ def _panel(ax, points, title, xlabel='microseconds per call',
         ax.legend(fontsize=7, loc='upper right')
     ax.set_xscale('log')
     ax.set_yscale('log')
+    # within a decade or two the minor ticks' labels ran into each other
+    from matplotlib.ticker import NullFormatter
+    ax.xaxis.set_minor_formatter(NullFormatter())
     ax.set_title(title, fontsize=9)
     ax.set_xlabel(xlabel, fontsize=8)
     ax.set_ylabel(ylabel, fontsize=8)
@@ -114,7 +117,10 @@ def robot_pareto(records, robot, path):
                             'FD': 'qdd = forward dynamics'}[quantity])
     fig.suptitle(f'{robot} ({dof} joints): error against time; lower left '
                  f'is better', fontsize=11)
-    fig.tight_layout()
+    # fixed margins: tight_layout drew every log axis once more to measure
+    # it, 60 % of the report's time (2.0 of 3.4 s a figure)
+    fig.subplots_adjust(left=0.05, right=0.98, bottom=0.07, top=0.91,
+                        wspace=0.25, hspace=0.32)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
