@@ -44,7 +44,7 @@ def aba_velocities(links, frames, qd, wrench, fext, velocity_on,
     Stores R, p (``ws``), v_j, c_j = v_j x S_j qd_j, the link's spatial
     inertia as the starting articulated inertia IA_j and its bias force
     pA_j = v_j x* (I_j v_j), plus the tip's wrench on the tool's body and
-    the links' own wrenches (``fext``).
+    the links' own wrenches (``fext``; None: none).
     """
     n = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
@@ -87,10 +87,11 @@ def aba_velocities(links, frames, qd, wrench, fext, velocity_on,
                            frame_rotation(links, frames, ws, j))
             pa = (pa[0] + e[0], pa[1] + e[1], pa[2] + e[2],
                   pa[3] + e[3], pa[4] + e[4], pa[5] + e[5])
-        if link_wrenches:
-            fe, ne = link_wrench(links, fext, j)
-            pa = (pa[0] + ne[0], pa[1] + ne[1], pa[2] + ne[2],
-                  pa[3] + fe[0], pa[4] + fe[1], pa[5] + fe[2])
+        if fext is not None:        # (compiled away when None)
+            if link_wrenches:
+                fe, ne = link_wrench(links, fext, j)
+                pa = (pa[0] + ne[0], pa[1] + ne[1], pa[2] + ne[2],
+                      pa[3] + fe[0], pa[4] + fe[1], pa[5] + fe[2])
         for k in range(6):
             aw[j, A_V + k] = v[k]
             aw[j, A_C + k] = c[k]

@@ -145,7 +145,7 @@ def momentum_terms_row(links, frames, q, qd, ws, cw, terms):
 def forward_dynamics_row(links, frames, q, qd, tau, wrench, flags, ws, aw,
                          qdd):
     """Compute qdd by the articulated-body algorithm (``articulated_body``)."""
-    bad = articulated_body(links, frames, q, qd, tau, wrench, ws,
+    bad = articulated_body(links, frames, q, qd, tau, wrench, None,
                            (flags & GRAVITY) != 0, (flags & VELOCITY) != 0,
                            (flags >> WRENCH_SHIFT) & WRENCH_BITS, False, ws,
                            aw, qdd)
