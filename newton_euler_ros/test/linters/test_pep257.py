@@ -12,10 +12,16 @@
 # See the License for the specific language governing permissions and
 # limitations under the License.
 
-"""ament_pep257 (docstring conventions) over the package + tools/."""
+"""
+ament_pep257 (docstring conventions) over the package + tools/.
+
+Each file is checked once per content (``lint_record``).
+"""
 import os
 
 from ament_pep257.main import main
+from lint_record import not_passed, python_files, record_passed, \
+    record_path
 import pytest
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.dirname(
@@ -31,5 +37,11 @@ PATHS = ['.'] + ([TOOLS] if os.path.isdir(os.path.join(PACKAGE_DIR, TOOLS))
 def test_pep257(monkeypatch):
     # Paths are relative to the package directory, not pytest's cwd.
     monkeypatch.chdir(PACKAGE_DIR)
-    rc = main(argv=['.', 'test', *PATHS[1:]])
+    record = record_path('pep257', test_pep257)
+    files = not_passed(record, python_files(PATHS))
+    print(f'{len(files)} files to check (the others passed as they are)')
+    if not files:
+        return
+    rc = main(argv=files)
     assert rc == 0, 'Found code style errors / warnings'
+    record_passed(record, files)
