@@ -90,7 +90,7 @@ def _panel(ax, points, title, xlabel='microseconds per call',
     # within a decade or two the minor ticks' labels ran into each other
     from matplotlib.ticker import NullFormatter
     ax.xaxis.set_minor_formatter(NullFormatter())
-    ax.set_title(title, fontsize=9)
+    ax.set_title(title, fontsize=9, y=1.0)  # fixed: no measuring draw
     ax.set_xlabel(xlabel, fontsize=8)
     ax.set_ylabel(ylabel, fontsize=8)
     ax.grid(True, which='major', alpha=0.3)
@@ -163,7 +163,8 @@ def scaling(records, exponents, path, fit_from):
     ax.set_yscale('log')
     ax.set_xlabel('number of links n (random chains)')
     ax.set_ylabel('microseconds per call')
-    ax.set_title('Cost growth with n; legend: fitted exponent p of c n^p')
+    ax.set_title('Cost growth with n; legend: fitted exponent p of c n^p',
+                 y=1.0)
     ax.grid(True, which='both', alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
@@ -201,7 +202,7 @@ def integrators(records, path):
             ax.set_yscale('log')
             ax.set_xlabel('wall seconds per simulated second', fontsize=8)
             ax.set_ylabel(ylabel, fontsize=8)
-            ax.set_title(scene, fontsize=9)
+            ax.set_title(scene, fontsize=9, y=1.0)
             ax.grid(True, alpha=0.3)
             ax.legend(fontsize=7)
     fig.tight_layout()
