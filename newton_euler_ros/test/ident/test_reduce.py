@@ -21,9 +21,8 @@ rows: ||R_j [x; -1]|| = ||A_j x - y_j||, and so R_j^T R_j = [A_j y_j]^T
 [A_j y_j].  Each joint folds only the columns its rows have had nonzero;
 R_j is built with every column when read.
 """
-import numpy as np
-
 from newton_euler_ros.ident.reduce import Reduced
+import numpy as np
 
 
 def _chunks(rng, n, p, used, m):
