@@ -82,7 +82,10 @@ def not_passed(record, files):
 
 
 def record_passed(record, files):
-    """Add ``files`` (each just passed) to the record."""
-    os.makedirs(os.path.dirname(record), exist_ok=True)
-    with open(record, 'a', encoding='ascii') as fh:
-        fh.write(''.join(_file_digest(f) + '\n' for f in files))
+    """Add ``files`` (each just passed) to the record, if it can be kept."""
+    try:
+        os.makedirs(os.path.dirname(record), exist_ok=True)
+        with open(record, 'a', encoding='ascii') as fh:
+            fh.write(''.join(_file_digest(f) + '\n' for f in files))
+    except OSError:         # a read-only cache: the next run lints again
+        pass

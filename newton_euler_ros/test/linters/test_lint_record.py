@@ -39,6 +39,12 @@ def test_a_changed_file_is_linted_again(tmp_path, monkeypatch):
     assert not_passed(record, files) == [str(a)]
     monkeypatch.setenv('NEWTON_EULER_RECHECK', '1')
     assert not_passed(record, files) == files
+    # a cache that cannot be written: no record, no error
+    (tmp_path / 'a_file').write_text('')
+    nowhere = str(tmp_path / 'a_file' / 'record')
+    record_passed(nowhere, files)
+    monkeypatch.delenv('NEWTON_EULER_RECHECK')
+    assert not_passed(nowhere, files) == files
 
 
 def test_the_record_is_per_linter_and_options(monkeypatch, tmp_path):
