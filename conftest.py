@@ -24,10 +24,26 @@ workspace without the peers) may still skip.  The one skip allowed is
 ``ament_copyright``, which exists only in an apt ROS 2 install.
 """
 import os
+import signal
 
 import pytest
 
 ALLOWED = ('ament_copyright',)
+
+
+def pytest_configure(config):
+    """
+    Give the commands the tests start a Ctrl-C that works.
+
+    A shell without job control starts a background command (``make test
+    &`` in a script) with SIGINT and SIGQUIT ignored, and every process
+    it starts inherits that: the tests that interrupt a command
+    (``test_cli_exit_status.py``) would then wait on a command that
+    cannot hear them.  pytest restores Python's own handler here, which
+    its children do not inherit: they start with the default.
+    """
+    if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def _strict():

@@ -134,6 +134,7 @@ def beside_the_graph(command, args):
     from sensor_msgs.msg import JointState
     from trajectory_msgs.msg import JointTrajectory
     probe = Probe(DOMAIN, name='exit_status_probe')
+    proc = None
     try:
         pub = probe.publisher(JointState, STATE_TOPIC)
         if command == 'send':
@@ -165,6 +166,9 @@ def beside_the_graph(command, args):
             assert probe.spin_until(lambda: len(got) == 1, 10.0)
         return proc.returncode, err
     finally:
+        if proc is not None and proc.poll() is None:
+            proc.kill()
+            proc.communicate()
         probe.close()
 
 
@@ -251,10 +255,16 @@ def test_interrupted_is_130(command, files, tmp_path):
                                 stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True,
                                 env=ros_env(DOMAIN))
-        time.sleep(delay)
-        assert proc.poll() is None, proc.communicate()
-        proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=60)
+        try:
+            time.sleep(delay)
+            assert proc.poll() is None, proc.communicate()
+            proc.send_signal(signal.SIGINT)
+            _, err = proc.communicate(timeout=60)
+        finally:
+            # a command that did not stop must not outlive the test
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
         if proc.returncode != -signal.SIGINT:
             break
     assert proc.returncode == 130, err
