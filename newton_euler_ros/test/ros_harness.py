@@ -20,6 +20,7 @@ localhost.  The node under test runs as its own process through its
 console script; the test talks to it from a separate rclpy context.
 """
 import os
+import signal
 import sys
 import time
 
@@ -27,6 +28,23 @@ from newton_euler_tools.processes import ChildProcess, ros_env  # noqa: F401
 
 PACKAGE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PARAMS_DIR = os.path.join(PACKAGE_DIR, 'config', 'params')
+
+
+def interrupt(proc, timeout):
+    """
+    Ctrl-C a command started with pipes; return its (stdout, stderr).
+
+    A command that has not stopped when this returns or raises (a timeout)
+    is killed: it must not outlive the test, a core busy for the rest of
+    the run.
+    """
+    try:
+        proc.send_signal(signal.SIGINT)
+        return proc.communicate(timeout=timeout)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
 
 
 def domain_id(offset):

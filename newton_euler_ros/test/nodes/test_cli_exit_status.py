@@ -36,7 +36,8 @@ import pytest
 
 pytest.importorskip('rclpy')
 
-from ros_harness import domain_id, PACKAGE_DIR, Probe, ros_env  # noqa: E402
+from ros_harness import (domain_id, interrupt, PACKAGE_DIR,  # noqa: E402
+                         Probe, ros_env)
 
 DOMAIN = domain_id(71)
 CHAIN = ['--base', BASE, '--tip', TIP]
@@ -255,16 +256,9 @@ def test_interrupted_is_130(command, files, tmp_path):
                                 stdout=subprocess.PIPE,
                                 stderr=subprocess.PIPE, text=True,
                                 env=ros_env(DOMAIN))
-        try:
-            time.sleep(delay)
-            assert proc.poll() is None, proc.communicate()
-            proc.send_signal(signal.SIGINT)
-            _, err = proc.communicate(timeout=60)
-        finally:
-            # a command that did not stop must not outlive the test
-            if proc.poll() is None:
-                proc.kill()
-                proc.communicate()
+        time.sleep(delay)
+        assert proc.poll() is None, proc.communicate()
+        _, err = interrupt(proc, 60)
         if proc.returncode != -signal.SIGINT:
             break
     assert proc.returncode == 130, err

@@ -34,8 +34,8 @@ pytest.importorskip('rclpy')
 
 # After the skip: pytest must be imported first, hence E402 and I100.
 from newton_euler_ros.ident.bag import read_joint_states  # noqa: E402, I100
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+from ros_harness import (domain_id, id_node_cmd, interrupt,  # noqa: E402
+                         NodeProcess, Probe)
 
 pytestmark = pytest.mark.ros
 
@@ -76,7 +76,6 @@ def _stamp_ns(msg):
 def test_send_through_the_node_and_record_a_bag(tmp_path):
     """Send through the node into the simulator; record; stop on Ctrl-C."""
     import re
-    import signal
     from sensor_msgs.msg import JointState
     from newton_euler_ros.sim.scene import scene_dirs
     domain = domain_id(11)
@@ -124,11 +123,11 @@ def test_send_through_the_node_and_record_a_bag(tmp_path):
             + int((MOVE + 0.5) * 1e9)
         assert probe.spin_until(
             lambda: live and _stamp_ns(live[-1]) >= after, 60.0), sim.log()
-        recorder.send_signal(signal.SIGINT)
-        out, err = recorder.communicate(timeout=30)
+        out, err = interrupt(recorder, 30)
     finally:
         if recorder.poll() is None:
             recorder.kill()
+            recorder.communicate()
         probe.close()
         status = [node.stop(), sim.stop()]
     assert recorder.returncode == 0, out + err
