@@ -50,7 +50,9 @@ def calls(core, m, rng):
                               core.mass_matrix_batch(m, Q))
     yield 'derivatives', lambda: (
         core.inverse_dynamics_derivatives(m, q, qd, qdd),
-        core.forward_dynamics_derivatives(m, q, qd, qdd))
+        core.forward_dynamics_derivatives(m, q, qd, qdd),
+        core.inverse_dynamics_derivatives_batch(m, Q, QD, QDD, threads=2),
+        core.forward_dynamics_derivatives_batch(m, Q, QD, QDD, threads=2))
     if wrenches:
         for frame in ('base', 'link'):
             yield f'link wrenches ({frame})', lambda frame=frame: (

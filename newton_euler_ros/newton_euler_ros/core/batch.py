@@ -21,11 +21,99 @@ of states, check them once in numpy (shapes, finiteness) and run the
 batch entry point of their kernel (``kernels/entry.py``, beside the
 single-state one): no Python work per state.  All are importable from
 :mod:`newton_euler_ros.core` and :mod:`newton_euler_ros.core.dynamics`.
+
+:func:`run_split` shares a batch among threads, each with its own
+workspace, for the loops that release the GIL (the derivatives'): the
+rows are independent, so the result is the same bit for bit whatever
+the number of threads.
 """
+from concurrent.futures import ThreadPoolExecutor
+import os
+import threading
+
 import numpy as np
 
 from . import kernels as K
 from .calling import matrix, out_array, status_error, workspace, wrench_mode
+from .errors import DynamicsInputError
+from .workspace import Workspace
+
+ROWS_PER_THREAD = 32        # fewer rows a thread: starting it costs more
+_POOL = [None, 0, 0]        # the shared pool, its workers, its process
+_POOL_LOCK = threading.Lock()
+_CORES = [None]
+
+
+def usable_cores():
+    """Return the number of cores this process may run on (asked once)."""
+    if _CORES[0] is None:
+        try:
+            _CORES[0] = len(os.sched_getaffinity(0))
+        except AttributeError:          # not on Linux
+            _CORES[0] = os.cpu_count() or 1
+    return _CORES[0]
+
+
+def row_ranges(m, threads=None):
+    """
+    Return the (lo, hi) row ranges of m rows shared among ``threads``.
+
+    None: one thread per usable core, but no fewer than
+    ``ROWS_PER_THREAD`` rows a thread; 1: the whole batch here.
+    """
+    if threads is None:
+        threads = min(usable_cores(), max(1, m // ROWS_PER_THREAD))
+    elif type(threads) is not int or threads < 1:
+        raise DynamicsInputError(
+            f'threads must be None or a whole number >= 1, got {threads!r}')
+    threads = max(1, min(threads, m))
+    edges = [m * k // threads for k in range(threads + 1)]
+    return list(zip(edges[:-1], edges[1:]))
+
+
+def _pool(workers):
+    """Return the shared pool, with at least ``workers`` threads."""
+    with _POOL_LOCK:
+        if _POOL[1] < workers or _POOL[2] != os.getpid():
+            if _POOL[0] is not None and _POOL[2] == os.getpid():
+                _POOL[0].shutdown(wait=False)
+            # (a forked child has the pool but not its threads: a new one)
+            _POOL[:] = [ThreadPoolExecutor(
+                workers, thread_name_prefix='newton_euler_batch'), workers,
+                os.getpid()]
+        return _POOL[0]
+
+
+def run_split(model, ws, m, threads, kernel, arguments, Q=None):
+    """
+    Run ``kernel(*arguments(lo, hi, w))`` over the row ranges of m rows.
+
+    The first range runs in this thread with ``ws``, the others on the
+    shared pool, each with a workspace of its own (kept on ``ws``); the
+    kernel must release the GIL (``kernels.BATCH``).  It returns the
+    failed row of its range or -1 (its code in ``w.status``); the first
+    failed row of the batch is raised.
+    """
+    ranges = row_ranges(m, threads)
+    if len(ranges) == 1:
+        _check(kernel(*arguments(0, m, ws)), ws, model, Q)
+        return
+    spaces = [ws] + helper_workspaces(model, ws, len(ranges) - 1)
+    pool = _pool(len(ranges) - 1)
+    futures = [pool.submit(kernel, *arguments(lo, hi, w))
+               for (lo, hi), w in zip(ranges[1:], spaces[1:])]
+    rows = [kernel(*arguments(*ranges[0], ws))]
+    rows += [f.result() for f in futures]
+    for (lo, _), w, row in zip(ranges, spaces, rows):
+        _check(row if row < 0 else lo + row, w, model, Q)
+
+
+def helper_workspaces(model, ws, count):
+    """Return ``count`` more workspaces for ``ws``'s model, made once."""
+    helpers = ws.helpers
+    while len(helpers) < count:
+        helpers.append(Workspace(model, ws.dtype))
+    return helpers[:count]
 
 
 def _states(model, ws, Q, QD, name_qd='QD'):

@@ -220,9 +220,8 @@ def matrix(name, X, cols, rows=None):
             f'{name} must have shape {want}, got {X.shape}')
     if not X.flags.writeable:
         X = X.copy()
-    bad = np.argwhere(~np.isfinite(X))
-    if bad.size:
-        r, c = bad[0]
+    if not np.isfinite(X).all():
+        r, c = np.argwhere(~np.isfinite(X))[0]
         raise DynamicsInputError(
             f'{name}[{r}, {c}] is {float(X[r, c])!r}; every entry must be '
             f'finite')

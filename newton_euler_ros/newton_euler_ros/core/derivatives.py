@@ -48,6 +48,7 @@ from numba import types
 import numpy as np
 
 from . import kernels as K
+from .batch import run_split
 from .calling import (FD_INPUTS, foreign_workspace, INPUTS, inputs,
                       INT, MAT, matrix, out_array, PACKED, Refused,
                       status_error, strict_entry, VEC, vector, workspace,
@@ -223,23 +224,30 @@ def _converted(model, ws, names, given, wrench, wrench_frame, flags, drives,
 
 def inverse_dynamics_derivatives_batch(model, Q, QD, QDD, W=None,
                                        wrench_frame='base', *, gravity=True,
-                                       drives=None, ws=None, out=None):
+                                       drives=None, threads=None, ws=None,
+                                       out=None):
     """
     :func:`inverse_dynamics_derivatives` for each row of (m, n) states.
 
     ``W``: (m, 6) end-effector wrenches or None.  Returns (DQ, DQD), two
     (m, n, n) arrays (views of one (m, 2, n, n), or ``out``).  One
     compiled loop: no Python work per state (with ``drives``, their
-    slopes added to the diagonals in numpy).
+    slopes added to the diagonals in numpy).  ``threads``: share the
+    rows among that many threads (None: one a core, at least 32 rows
+    each; 1: this thread only); the result is the same bit for bit.
     """
     ws, Q, QD, X, W, flags = _batch_inputs(model, ws, Q, QD, QDD, 'QDD', W,
                                            wrench_frame, gravity)
     m = Q.shape[0]
     res = out_array(out, (m, 2, ws.n, ws.n))
-    row = K.run_inverse_dynamics_derivatives_batch(
-        model.packed, Q, QD, X, W, ws.zeros, flags, ws.ws, ws.cw, ws.dw, res,
-        ws.status)
-    _raise_row(row, ws, model, Q)
+    P = model.packed
+
+    def arguments(lo, hi, w):
+        return (P, Q[lo:hi], QD[lo:hi], X[lo:hi], W[lo:hi], w.zeros, flags,
+                w.ws, w.cw, w.dw, res[lo:hi], w.status)
+
+    run_split(model, ws, m, threads, K.run_inverse_dynamics_derivatives_batch,
+              arguments, Q)
     if drives is not None:
         i = np.arange(ws.n)
         res[:, 1, i, i] += drive_slopes(drives, QD)
@@ -248,21 +256,27 @@ def inverse_dynamics_derivatives_batch(model, Q, QD, QDD, W=None,
 
 def forward_dynamics_derivatives_batch(model, Q, QD, TAU, W=None,
                                        wrench_frame='base', *, gravity=True,
-                                       ws=None, out=None):
+                                       threads=None, ws=None, out=None):
     """
     :func:`forward_dynamics_derivatives` for each row of (m, n) states.
 
     Returns (DQ, DQD, DTAU), three (m, n, n) arrays (views of one
-    (m, 3, n, n), or ``out``).  One compiled loop.
+    (m, 3, n, n), or ``out``).  One compiled loop; ``threads`` as
+    :func:`inverse_dynamics_derivatives_batch` takes it.
     """
     ws, Q, QD, X, W, flags = _batch_inputs(model, ws, Q, QD, TAU, 'TAU', W,
                                            wrench_frame, gravity)
     m = Q.shape[0]
     res = out_array(out, (m, 3, ws.n, ws.n))
-    row = K.run_forward_dynamics_derivatives_batch(
-        model.packed, Q, QD, X, W, ws.zeros, ws.zeros, flags, ws.ws, ws.cw,
-        ws.dw, ws.chol, ws.scratch, res, ws.status)
-    _raise_row(row, ws, model, Q)
+    P = model.packed
+
+    def arguments(lo, hi, w):
+        return (P, Q[lo:hi], QD[lo:hi], X[lo:hi], W[lo:hi], w.zeros, w.zeros,
+                flags, w.ws, w.cw, w.dw, w.chol, w.scratch, res[lo:hi],
+                w.status)
+
+    run_split(model, ws, m, threads, K.run_forward_dynamics_derivatives_batch,
+              arguments, Q)
     return res[:, 0], res[:, 1], res[:, 2]
 
 
@@ -278,9 +292,3 @@ def _batch_inputs(model, ws, Q, QD, X, name, W, wrench_frame, gravity):
         W, mode = matrix('W', W, 6, m), wrench_mode(W, wrench_frame)
     flags = (K.GRAVITY if gravity else 0) | (mode << K.WRENCH_SHIFT)
     return ws, Q, QD, X, W, flags
-
-
-def _raise_row(row, ws, model, Q):
-    if row >= 0:
-        raise status_error(int(ws.status[0]), model=model, q=Q[row], ws=ws,
-                           row=row)

@@ -215,8 +215,10 @@ def _derivatives(model, Q, QD, tau, wrench, wrench_frame, drives, gravity,
         if wrench is not None:
             W = np.tile(np.asarray(wrench, dtype=np.float64),
                         (Q.shape[0], 1))
+        # one thread: a node beside a robot's stack takes no other core
         return forward_dynamics_derivatives_batch(
-            model, Q, QD, tau, W, wrench_frame, gravity=gravity, ws=ws)
+            model, Q, QD, tau, W, wrench_frame, gravity=gravity, threads=1,
+            ws=ws)
     # the batch takes neither drive terms nor wrenches at links
     m, n = Q.shape
     out = np.empty((3, m, n, n))

@@ -31,6 +31,8 @@ class Workspace:
 
     ``dtype`` is the number type of the kernels it serves (float64, or
     float32 for :class:`~newton_euler_ros.core.float32.Float32Dynamics`).
+    ``helpers``: the workspaces of the threads a batch is shared among
+    (``core.batch.run_split``), made on first use.
     """
 
     def __init__(self, model, dtype=np.float64):
@@ -52,6 +54,7 @@ class Workspace:
         self.zeros = np.zeros(n, dtype)
         self.zero_wrench = np.zeros(6, dtype)
         self.status = np.zeros(1, np.int64)
+        self.helpers = []       # the other threads' (``batch.run_split``)
         # inputs given as lists or tuples, copied in (calling.sequences_in)
         self.given = np.zeros(3 * n + 6, dtype)
         self.given_rows = (self.given[:n], self.given[n:2 * n],

@@ -27,6 +27,7 @@ Analytical derivatives of tau and qdd (``core.derivatives``).
   inverse ones at qdd = FD(q, qd, tau), dg/dq symmetric.
 - Batches equal single calls; bad input gets a one-line error.
 """
+import multiprocessing
 import warnings
 
 from newton_euler_ros.core import (coriolis_matrix, Drives,
@@ -264,6 +265,55 @@ def test_batches_equal_single_calls():
         dq, dqd = inverse_dynamics_derivatives(
             arm, Q[k], QD[k], QDD[k], W[k], 'end_effector', drives=drives)
         assert np.array_equal(DQ[k], dq) and np.array_equal(DQD[k], dqd)
+
+
+def test_threads_share_a_batch_bit_for_bit():
+    model = quiet(torso())
+    rng = np.random.default_rng(12)
+    m = 70
+    Q, QD, QDD, TAU = rng.uniform(-1, 1, (4, m, model.n))
+    want_i = inverse_dynamics_derivatives_batch(model, Q, QD, QDD, threads=1)
+    want_f = forward_dynamics_derivatives_batch(model, Q, QD, TAU, threads=1)
+    for threads in (2, 3, None):
+        ws = Workspace(model)
+        got_i = inverse_dynamics_derivatives_batch(model, Q, QD, QDD,
+                                                   threads=threads, ws=ws)
+        got_f = forward_dynamics_derivatives_batch(model, Q, QD, TAU,
+                                                   threads=threads, ws=ws)
+        for a, b in zip(want_i + want_f, got_i + got_f):
+            assert np.array_equal(a, b)
+        if threads == 3:
+            assert len(ws.helpers) == 2     # the rows were shared
+    QD[60] = 1e200                  # overflows, in the third share
+    for call, third in ((inverse_dynamics_derivatives_batch, QDD),
+                        (forward_dynamics_derivatives_batch, TAU)):
+        with pytest.raises(DynamicsInputError, match='for row 60 '):
+            call(model, Q, QD, third, threads=3)
+        for bad in (0, -1, 1.5, True, '2'):
+            with pytest.raises(DynamicsInputError, match='threads must be'):
+                call(model, Q, QD, third, threads=bad)
+
+
+def _child_batch(model, Q, QD, QDD, want, queue):
+    got = inverse_dynamics_derivatives_batch(model, Q, QD, QDD, threads=2)
+    queue.put(all(np.array_equal(a, b) for a, b in zip(want, got)))
+
+
+def test_a_forked_child_shares_a_batch_among_threads():
+    # the child inherits the pool but not its threads: it must make its own
+    model = load_robot('puma560')
+    Q, QD, QDD = np.random.default_rng(13).uniform(-1, 1, (3, 80, model.n))
+    want = inverse_dynamics_derivatives_batch(model, Q, QD, QDD, threads=2)
+    context = multiprocessing.get_context('fork')
+    queue = context.Queue()
+    child = context.Process(target=_child_batch,
+                            args=(model, Q, QD, QDD, want, queue))
+    child.start()
+    child.join(60)
+    if child.is_alive():
+        child.kill()
+        pytest.fail('the forked child hung on a shared batch')
+    assert child.exitcode == 0 and queue.get(timeout=5)
 
 
 def test_lists_workspaces_and_out():

@@ -69,6 +69,10 @@ def test_every_entry_point_is_generated():
     assert set(K.RUN) == set(generate.SOURCES)
     for name, kernel in K.RUN.items():
         assert kernel.py_func.__name__ == name
+        # a batch loop releases the GIL (threads may share a batch); a
+        # single call does not (releasing it costs more than it saves)
+        nogil = kernel.targetoptions.get('nogil', False)
+        assert nogil == name.endswith('_batch'), name
 
 
 @pytest.mark.parametrize('name', SINGLE)

@@ -20,7 +20,7 @@ from the row steps and the ``ENTRIES`` table of ``entry.py`` (see
 ``generate.py`` for what each checks); ``test_entry_points.py`` fails
 when this file differs from what the generator writes.
 """
-from ._jit import ENTRY, njit
+from ._jit import BATCH, ENTRY, njit
 from .entry import (_coordinates, _split, coriolis_matrix_composite_row,
                     coriolis_matrix_row, forward_dynamics_links_row,
                     forward_dynamics_row, gravity_torques_row,
@@ -67,7 +67,7 @@ def run_inverse_dynamics(P, q, qd, qdd, wrench, flags, ws, tau):
                                 tau)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_inverse_dynamics_batch(P, Q, QD, QDD, WRENCH, flags, ws, TAU, status):
     """inverse_dynamics_row for each row k (see generate.py)."""
     links, frames = _split(P)
@@ -143,7 +143,7 @@ def run_gravity_torques(P, q, ws, tau):
     return gravity_torques_row(links, frames, q, ws, tau)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_gravity_torques_batch(P, Q, ws, TAU, status):
     """gravity_torques_row for each row k (see generate.py)."""
     links, frames = _split(P)
@@ -177,7 +177,7 @@ def run_mass_matrix_crba(P, q, ws, D):
     return mass_matrix_crba_row(links, frames, q, ws, D)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_mass_matrix_batch(P, Q, ws, D, status):
     """mass_matrix_crba_row for each row k (see generate.py)."""
     links, frames = _split(P)
@@ -251,7 +251,7 @@ def run_coriolis_matrix(P, q, qd, composite, ws, cw, scratch, C):
                                scratch, C)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_coriolis_matrix_batch(P, Q, QD, ws, cw, C, status):
     """coriolis_matrix_composite_row for each row k (see generate.py)."""
     links, frames = _split(P)
@@ -335,7 +335,7 @@ def run_forward_dynamics(P, q, qd, tau, wrench, flags, ws, aw, qdd):
                                 aw, qdd)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_forward_dynamics_batch(P, Q, QD, TAU, WRENCH, flags, ws, aw, QDD,
                                status):
     """forward_dynamics_row for each row k (see generate.py)."""
@@ -447,7 +447,7 @@ def run_link_poses(P, q, ws, Ts):
     return link_poses_row(links, frames, q, ws, Ts)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_regressor_batch(P, Q, QD, QDD, drives, eps, ws, line, acc, Y, status):
     """regressor_row for each row k (see generate.py)."""
     links, frames = _split(P)

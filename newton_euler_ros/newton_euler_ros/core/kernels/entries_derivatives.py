@@ -20,7 +20,7 @@ from the row steps and the ``ENTRIES`` table of ``entry.py`` (see
 ``generate.py`` for what each checks); ``test_entry_points.py`` fails
 when this file differs from what the generator writes.
 """
-from ._jit import ENTRY, njit
+from ._jit import BATCH, ENTRY, njit
 from .entry import (_coordinates, _split,
                     forward_dynamics_derivatives_links_row,
                     forward_dynamics_derivatives_row,
@@ -81,7 +81,7 @@ def run_inverse_dynamics_derivatives(P, q, qd, qdd, wrench, damping, flags, ws,
                                             damping, flags, ws, cw, dw, dtau)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_inverse_dynamics_derivatives_batch(P, Q, QD, QDD, WRENCH, damping,
                                            flags, ws, cw, dw, DTAU, status):
     """inverse_dynamics_derivatives_row for each row k (see generate.py)."""
@@ -224,7 +224,7 @@ def run_forward_dynamics_derivatives(P, q, qd, tau, wrench, armature, damping,
                                             dw, chol, scratch, dqdd)
 
 
-@njit(**ENTRY)
+@njit(**BATCH)
 def run_forward_dynamics_derivatives_batch(P, Q, QD, TAU, WRENCH, armature,
                                            damping, flags, ws, cw, dw, chol,
                                            scratch, DQDD, status):

@@ -35,7 +35,9 @@ name is a switch passed through (``flags``, ``crba``).  From it:
   status)``: the row step on row k of (m, ...) inputs and output (their
   names in capitals), the other arguments shared; it returns -1, or the
   first row whose code is not -1 (that code in ``status[0]``).  The
-  caller checks shapes and finiteness once, in numpy.
+  caller checks shapes and finiteness once, in numpy.  It is compiled to
+  release the GIL (``_jit.BATCH``), so a caller may share a batch among
+  threads (``core.batch.run_split``).
 
 The entry points are written into checked-in modules (:data:`FILES`:
 ``entries.py``, and ``entries_derivatives.py`` for the derivatives),
@@ -248,7 +250,9 @@ def render(source=None):
 
 def _module(what, texts):
     """Return the text of one generated file: ``texts`` and their imports."""
-    body = '\n\n'.join('@njit(**ENTRY)\n' + t for t in texts.values())
+    body = '\n\n'.join(
+        ('@njit(**BATCH)\n' if name.endswith('_batch') else '@njit(**ENTRY)\n')
+        + t for name, t in texts.items())
     used = set(re.findall(r'\b\w+\b', body))
     rows = sorted({r for r in used if r.endswith('_row')}
                   | ({'_coordinates'} & used) | {'_split'})
@@ -263,7 +267,8 @@ def _module(what, texts):
         'fails',
         'when this file differs from what the generator writes.',
         '"""']
-    lines.append('from ._jit import ENTRY, njit')
+    lines.append('from ._jit import ' + ', '.join(
+        [n for n in ('BATCH', 'ENTRY') if f'**{n}' in body] + ['njit']))
     lines += _wrap('from .entry import (', sorted(rows, key=str.lower), ')')
     for module, names in _IMPORTS:
         names = [n for n in names if n in used]
