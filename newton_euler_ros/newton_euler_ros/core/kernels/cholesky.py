@@ -72,3 +72,39 @@ def cholesky_solve_factored(L, b, x):
         for m in range(i + 1, n):
             acc -= L[m, i] * x[m]
         x[i] = acc / L[i, i]
+
+
+@njit(cache=True, inline='always')
+def cholesky_inverse(L, X, rd, one):
+    """
+    Write (L L^T)^-1 into X (not L), L from :func:`cholesky_factor`.
+
+    L^-1 goes into X's lower triangle, then row i of L^-T L^-1 (entry
+    (i, j), j <= i: the sum over m >= i of L^-1[m, i] L^-1[m, j]) into
+    its upper triangle (the diagonal last, once row i no longer reads
+    it), which is then mirrored: about n^3 / 3 multiply-adds and n
+    divisions (``rd``, n scratch: the reciprocal pivots), against n^3
+    and n^2 for n solves of unit vectors.  ``one``: 1 in L's type.
+    """
+    n = L.shape[0]
+    for i in range(n):
+        rd[i] = one / L[i, i]
+    for j in range(n):              # L^-1, column by column
+        X[j, j] = rd[j]
+        for i in range(j + 1, n):
+            acc = -L[i, j] * X[j, j]
+            for m in range(j + 1, i):
+                acc -= L[i, m] * X[m, j]
+            X[i, j] = acc * rd[i]
+    for i in range(n):              # L^-T L^-1, row i into column i
+        for j in range(i + 1):
+            acc = X[i, i] * X[i, j]
+            for m in range(i + 1, n):
+                acc += X[m, i] * X[m, j]
+            if j < i:
+                X[j, i] = acc
+            else:
+                X[i, i] = acc
+    for i in range(n):
+        for j in range(i):
+            X[i, j] = X[j, i]
