@@ -17,12 +17,14 @@ Analytical derivatives per call from Python, against Pinocchio's.
 
     python -m newton_euler_tools.bench_derivatives [--quick]
 
-Per call, best of several rounds, side by side in one run:
+Per call, best of several rounds, side by side in one run (each round
+times every call in turn):
 ``inverse_dynamics_derivatives`` against ``pin.computeRNEADerivatives``
 and ``forward_dynamics_derivatives`` against ``pin.computeABADerivatives``,
 on the Panda arm (7 joints, the chain to its flange) and on Centauro's
 whole tree (39 joints); then the batched forms per state against a
-Python loop of Pinocchio's calls.  Both read the same published URDFs
+Python loop of Pinocchio's calls, in one thread and shared among one
+thread a core (their default).  Both read the same published URDFs
 (example-robot-data).  Targets (issue 39): per call <= 1.0x Pinocchio on
 the arm and <= 0.8x on Centauro; batched at least 3x faster per state.
 """
@@ -33,9 +35,10 @@ from newton_euler_ros.core import (forward_dynamics_derivatives,
                                    inverse_dynamics_derivatives,
                                    inverse_dynamics_derivatives_batch,
                                    load_robot, load_urdf, Workspace)
+from newton_euler_ros.core.batch import usable_cores
 import numpy as np
 
-from .timing import min_time, quick_option
+from .timing import min_times, quick_option
 
 ROBOTS = (('panda', 'panda_description/urdf/panda.urdf', 'panda_link8',
            1.0),
@@ -94,22 +97,28 @@ def measure(relative, tip, number, repeat, m):
             model, q, qd, tau, ws=ws, out=out3),
         'pin dqdd': lambda: pin.computeABADerivatives(pm, pd, x, v, t),
     }
-    times = {k: min_time(f, number, repeat) for k, f in calls.items()}
-    times['ours dtau batch'] = min_time(
-        lambda: inverse_dynamics_derivatives_batch(model, Q, QD, QDD, ws=ws,
-                                                   out=outb2), 1, repeat) / m
-    times['pin dtau batch'] = min_time(loop_rnea, 1, repeat) / m
-    times['ours dqdd batch'] = min_time(
-        lambda: forward_dynamics_derivatives_batch(model, Q, QD, TAU, ws=ws,
-                                                   out=outb3), 1, repeat) / m
-    times['pin dqdd batch'] = min_time(loop_aba, 1, repeat) / m
+    times = min_times(calls, number, repeat)
+    batches = {}
+    for tag, threads in (('batch1', 1), ('batch', None)):
+        batches[f'ours dtau {tag}'] = (
+            lambda t=threads: inverse_dynamics_derivatives_batch(
+                model, Q, QD, QDD, threads=t, ws=ws, out=outb2))
+        batches[f'ours dqdd {tag}'] = (
+            lambda t=threads: forward_dynamics_derivatives_batch(
+                model, Q, QD, TAU, threads=t, ws=ws, out=outb3))
+    batches['pin dtau batch'] = loop_rnea
+    batches['pin dqdd batch'] = loop_aba
+    for name, seconds in min_times(batches, 1, repeat).items():
+        times[name] = seconds / m
+    times['pin dtau batch1'] = times['pin dtau batch']
+    times['pin dqdd batch1'] = times['pin dqdd batch']
     return n, times
 
 
 def main(argv=None):
     """Print the table: us per call, ratios, verdicts."""
     quick = quick_option(__doc__, 'fewer calls and rounds (noisier)', argv)
-    number, repeat, m = (200, 3, 50) if quick else (2000, 7, 500)
+    number, repeat, m = (200, 5, 50) if quick else (2000, 7, 500)
     print(f'derivatives per call from Python, best of {repeat} rounds of '
           f'{number} calls (batches: {m} states), us')
     print(f'{"robot":<9}{"n":>3}  {"call":<6}{"ours":>8}{"pinocchio":>11}'
@@ -121,6 +130,8 @@ def main(argv=None):
             print(f'{label}: skipped ({exc})')
             continue
         for call, limit in (('dtau', target), ('dqdd', target),
+                            ('dtau batch1', BATCH_TARGET),
+                            ('dqdd batch1', BATCH_TARGET),
                             ('dtau batch', BATCH_TARGET),
                             ('dqdd batch', BATCH_TARGET)):
             ours, theirs = t[f'ours {call}'], t[f'pin {call}']
@@ -131,7 +142,9 @@ def main(argv=None):
                   f'{"PASS" if ratio <= limit else "MISS"}')
     print('dtau: inverse_dynamics_derivatives vs computeRNEADerivatives; '
           'dqdd: forward_dynamics_derivatives vs computeABADerivatives; /b: '
-          'batched, per state, vs a Python loop of Pinocchio calls')
+          'batched, per state, vs a Python loop of Pinocchio calls (/b1: '
+          f'in one thread; /b: shared among {usable_cores()} threads, one a '
+          'core)')
     return 0
 
 

@@ -35,6 +35,27 @@ def min_time(fn, number=1, repeat=5):
     return best
 
 
+def min_times(fns, number=1, repeat=5):
+    """
+    Return {name: best time per call} of ``fns`` ({name: callable}).
+
+    Timed side by side: each of the ``repeat`` rounds times ``number``
+    calls of every callable in turn, so a slow spell of the machine
+    (seconds long on a shared one) falls on all of them, not on one.
+    """
+    for fn in fns.values():
+        fn()
+    best = dict.fromkeys(fns, float('inf'))
+    for _ in range(repeat):
+        for name, fn in fns.items():
+            start = time.perf_counter()
+            for _ in range(number):
+                fn()
+            best[name] = min(best[name],
+                             (time.perf_counter() - start) / number)
+    return best
+
+
 def tool_parser(module, description, quick=None):
     """
     Return the parser of ``python -m newton_euler_tools.MODULE``.
