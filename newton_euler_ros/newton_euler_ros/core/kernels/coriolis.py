@@ -20,7 +20,7 @@ linear] and a force [moment; force], at the origin of frame 0 (the
 convention of Featherstone's book).
 """
 from ._jit import njit
-from .kinematics import (body_inertia, branch_point, branched, has_mimic,
+from .kinematics import (branch_point, branched, has_mimic, inertia_parts,
                          joint_rate, joint_trig, link_geometry, parent,
                          put_pair, revolute, zero_matrix)
 from .layout import (C_HALF, C_ONE, C_ZERO, CS_BC, CS_H, CS_IC, CW_F1, CW_F2,
@@ -28,9 +28,50 @@ from .layout import (C_HALF, C_ONE, C_ZERO, CS_BC, CS_H, CS_IC, CW_F1, CW_F2,
                      DS_F, DS_W, DW_A, DW_ACC, DW_C, DW_E, DW_T, DW_U, DW_W,
                      DW_Y,
                      F_CONST, OVERFLOW)
-from .spatial import (cross, load3, load9, mat6_vec, matmul, rot, rot_t, skew,
-                      vec6)
+from .spatial import cross, load3, load9, matmul, rot, rot_t, vec6
 from .status import matrix_status
+
+# The composites' columns, IC then BC (``CS_IC`` = 0): what a branch's
+# later children carry back to it (``CW_ICA``, ``CW_BCA``, in that order).
+SUMS = CS_H
+
+
+@njit(cache=True, inline='always')
+def inertia_times(arr, row, col, x):
+    """
+    Return I x of a spatial inertia ``arr[row, col:col + 10]`` (``CW_I``).
+
+    With J its rotational inertia about the origin, h = m c and m:
+    I [w; v] = [J w + h x v; m v - h x w], 24 multiplications.
+    """
+    Jxx = arr[row, col]
+    Jxy = arr[row, col + 1]
+    Jxz = arr[row, col + 2]
+    Jyy = arr[row, col + 3]
+    Jyz = arr[row, col + 4]
+    Jzz = arr[row, col + 5]
+    h = (arr[row, col + 6], arr[row, col + 7], arr[row, col + 8])
+    m = arr[row, col + 9]
+    a = cross(h[0], h[1], h[2], x[3], x[4], x[5])
+    b = cross(h[0], h[1], h[2], x[0], x[1], x[2])
+    return (Jxx * x[0] + Jxy * x[1] + Jxz * x[2] + a[0],
+            Jxy * x[0] + Jyy * x[1] + Jyz * x[2] + a[1],
+            Jxz * x[0] + Jyz * x[1] + Jzz * x[2] + a[2],
+            m * x[3] - b[0], m * x[4] - b[1], m * x[5] - b[2])
+
+
+@njit(cache=True, inline='always')
+def coriolis_times(cw, n, x):
+    """
+    Return BC x of the running composite (scratch row n, ``CS_BC``).
+
+    BC = [[P, 0], [-[h_f], 0]], so BC [w; v] = [P w; w x h_f].
+    """
+    P = load9(cw, n, CS_BC)
+    hf = load3(cw, n, CS_BC + 9)
+    a = rot(P, x[0], x[1], x[2])
+    b = cross(x[0], x[1], x[2], hf[0], hf[1], hf[2])
+    return (a[0], a[1], a[2], b[0], b[1], b[2])
 
 
 @njit(cache=True, inline='always')
@@ -62,7 +103,7 @@ def coriolis_forward(links, frames, qd, ws, cw):
                 ow = load3(cw, par, CW_OW)
                 V = vec6(cw, par, CW_V)
         if branch_point(links, frames, j):
-            for k in range(72):
+            for k in range(SUMS):
                 cw[j, CW_ICA + k] = zero
         R, p = link_geometry(links, frames, j, ws)
         t = rot(Rw, p[0], p[1], p[2])
@@ -111,14 +152,14 @@ def coriolis_backward(links, frames, cw, dw, derivatives):
     """
     n = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
-    for k in range(72):
+    for k in range(SUMS):
         cw[n, k] = zero
     if derivatives:
         for k in range(21):
             dw[n, k] = zero
     for j in range(n - 1, -1, -1):
         if branch_point(links, frames, j):      # the later children's
-            for k in range(72):
+            for k in range(SUMS):
                 cw[n, k] += cw[j, CW_ICA + k]
             if derivatives:
                 for k in range(21):
@@ -126,16 +167,16 @@ def coriolis_backward(links, frames, cw, dw, derivatives):
         body_step(links, frames, cw, j, n)
         if derivatives:
             wrench_step(links, frames, cw, dw, j, n)
-        coriolis_vectors(frames, cw, j, n)
+        coriolis_vectors(cw, j, n)
         par = parent(links, j)
         if par != j - 1:        # a branch: into the parent's sums
             if par >= 0:
-                for k in range(72):
+                for k in range(SUMS):
                     cw[par, CW_ICA + k] += cw[n, k]
                 if derivatives:
                     for k in range(21):
                         dw[par, DW_ACC + k] += dw[n, k]
-            for k in range(72):
+            for k in range(SUMS):
                 cw[n, k] = zero
             if derivatives:
                 for k in range(21):
@@ -148,64 +189,78 @@ def body_step(links, frames, cw, j, n):
     Add body j to the running composites IC and BC (scratch row n).
 
     Writes I_j (frame 0, ``CW_I``) and h_j = I_j V_j (scratch ``CS_H``).
+    With I_j = [[J, [h]], [[h]^T, m 1]] and V_j = [w; v], the body's
+    B = (Y + Y^T + [I_j V_j]^) / 2 has the blocks (``docs/derivatives.md``)
+    [[P, 0], [-[h_f], 0]]: h_f = m v + w x h, the linear part of I_j V_j,
+    and P = sym([w] J) - sym(h v^T) + (h . v) 1 - [h_n] / 2, h_n its
+    angular part and sym(X) = (X + X^T) / 2.  So BC keeps 12 numbers.
     """
     half = frames[F_CONST, C_HALF]
-    BC = CS_BC
-    Rw = load9(cw, j, CW_RW)
-    ow = load3(cw, j, CW_OW)
-    body_inertia(links, j, Rw, ow, cw, j, CW_I)
+    J, h, m = inertia_parts(links, j, load9(cw, j, CW_RW),
+                            load3(cw, j, CW_OW))
+    for k in range(3):
+        cw[j, CW_I + k] = J[k]
+        cw[j, CW_I + 6 + k] = h[k]
+    cw[j, CW_I + 3] = J[4]
+    cw[j, CW_I + 4] = J[5]
+    cw[j, CW_I + 5] = J[8]
+    cw[j, CW_I + 9] = m
     V = vec6(cw, j, CW_V)
-    mat6_vec(cw, j, CW_I, V, cw, n, CS_H)
-    h = vec6(cw, n, CS_H)
-    # Y = (V x*) I, with V x* = [[w x, v x], [0, w x]], column by
-    # column: Y e = V x* (I e).  B = (Y + Y^T + H) / 2 with
-    # H = [h]^ = [[-[h_n], -[h_f]], [-[h_f], 0]].
-    Hn = skew((h[0], h[1], h[2]))
-    Hf = skew((h[3], h[4], h[5]))
-    for col in range(6):
-        b = CW_I + col
-        m0 = cw[j, b]
-        m1 = cw[j, b + 6]
-        m2 = cw[j, b + 12]
-        f0 = cw[j, b + 18]
-        f1 = cw[j, b + 24]
-        f2 = cw[j, b + 30]
-        t1 = cross(V[0], V[1], V[2], m0, m1, m2)
-        t2 = cross(V[3], V[4], V[5], f0, f1, f2)
-        t3 = cross(V[0], V[1], V[2], f0, f1, f2)
-        y = (t1[0] + t2[0], t1[1] + t2[1], t1[2] + t2[2],
-             t3[0], t3[1], t3[2])
-        for r in range(6):
-            # Y[r, col] goes to B[r, col] and, as Y^T, to B[col, r]
-            cw[n, BC + 6 * r + col] += half * y[r]
-            cw[n, BC + 6 * col + r] += half * y[r]
+    hv = inertia_times(cw, j, CW_I, V)
+    for k in range(6):
+        cw[n, CS_H + k] = hv[k]
+    # [w] J column by column, then P entry by entry
+    x0 = cross(V[0], V[1], V[2], J[0], J[3], J[6])
+    x1 = cross(V[0], V[1], V[2], J[1], J[4], J[7])
+    x2 = cross(V[0], V[1], V[2], J[2], J[5], J[8])
+    X = (x0[0], x1[0], x2[0], x0[1], x1[1], x2[1], x0[2], x1[2], x2[2])
     for r in range(3):
         for s in range(3):
-            cw[n, BC + 6 * r + s] -= half * Hn[3 * r + s]
-            cw[n, BC + 6 * r + s + 3] -= half * Hf[3 * r + s]
-            cw[n, BC + 6 * (r + 3) + s] -= half * Hf[3 * r + s]
-    for k in range(36):
+            if r == s:      # (h . v) - h_r v_r, without the cancellation
+                a = (r + 1) % 3
+                b = (r + 2) % 3
+                p = (half * (X[4 * r] + X[4 * r])
+                     + (h[a] * V[3 + a] + h[b] * V[3 + b]))
+            else:
+                p = half * ((X[3 * r + s] + X[3 * s + r])
+                            - (h[r] * V[3 + s] + V[3 + r] * h[s]))
+            cw[n, CS_BC + 3 * r + s] += p
+    # - [h_n] / 2
+    cw[n, CS_BC + 1] += half * hv[2]
+    cw[n, CS_BC + 2] -= half * hv[1]
+    cw[n, CS_BC + 3] -= half * hv[2]
+    cw[n, CS_BC + 5] += half * hv[0]
+    cw[n, CS_BC + 6] += half * hv[1]
+    cw[n, CS_BC + 7] -= half * hv[0]
+    for k in range(3):
+        cw[n, CS_BC + 9 + k] += hv[3 + k]
+    for k in range(10):
         cw[n, CS_IC + k] += cw[j, CW_I + k]
 
 
 @njit(cache=True, inline='always')
-def coriolis_vectors(frames, cw, j, n):
-    """F1 = IC S, F2 = BC^T S, G = IC Sdot + BC S of joint j (composites)."""
-    zero = frames[F_CONST, C_ZERO]
+def coriolis_vectors(cw, j, n):
+    """
+    F1 = IC S, F2 = BC^T S, G = IC Sdot + BC S of joint j (composites).
+
+    F2's linear part is zero (BC's right-hand column of blocks is zero);
+    only its angular part is stored.
+    """
     S = vec6(cw, j, CW_S)
     Sd = vec6(cw, j, CW_SD)
+    f1 = inertia_times(cw, n, CS_IC, S)
+    g = inertia_times(cw, n, CS_IC, Sd)
+    b = coriolis_times(cw, n, S)
+    # BC^T = [[P^T, [h_f]], [0, 0]]
+    P = load9(cw, n, CS_BC)
+    hf = load3(cw, n, CS_BC + 9)
+    a = rot_t(P, S[0], S[1], S[2])
+    c = cross(hf[0], hf[1], hf[2], S[3], S[4], S[5])
     for r in range(6):
-        f1 = zero
-        f2 = zero
-        g = zero
-        for s in range(6):
-            ic = cw[n, CS_IC + 6 * r + s]
-            f1 += ic * S[s]
-            f2 += cw[n, CS_BC + 6 * s + r] * S[s]
-            g += ic * Sd[s] + cw[n, CS_BC + 6 * r + s] * S[s]
-        cw[j, CW_F1 + r] = f1
-        cw[j, CW_F2 + r] = f2
-        cw[j, CW_G + r] = g
+        cw[j, CW_F1 + r] = f1[r]
+        cw[j, CW_G + r] = g[r] + b[r]
+    for r in range(3):
+        cw[j, CW_F2 + r] = a[r] + c[r]
 
 
 @njit(cache=True, inline='always')
@@ -233,11 +288,9 @@ def wrench_step(links, frames, cw, dw, j, n):
     b = cross(V[3], V[4], V[5], h[3], h[4], h[5])
     c = cross(V[0], V[1], V[2], h[3], h[4], h[5])
     vh = (a[0] + b[0], a[1] + b[1], a[2] + b[2], c[0], c[1], c[2])
+    ia = inertia_times(cw, j, CW_I, A)
     for r in range(6):
-        x = vh[r] + dw[j, DW_E + r]
-        for s in range(6):
-            x += cw[j, CW_I + 6 * r + s] * A[s]
-        dw[n, DS_F + r] += x
+        dw[n, DS_F + r] += vh[r] + dw[j, DW_E + r] + ia[r]
     for k in range(15):
         dw[n, DS_W + k] += dw[j, DW_W + k]
     S = vec6(cw, j, CW_S)
@@ -259,12 +312,10 @@ def wrench_step(links, frames, cw, dw, j, n):
     y = (a[0] + b[0] + Mw[0] - dn[0], a[1] + b[1] + Mw[1] - dn[1],
          a[2] + b[2] + Mw[2] - dn[2], c[0] - df[0], c[1] - df[1],
          c[2] - df[2])
+    bs = coriolis_times(cw, n, Sd)
+    ic = inertia_times(cw, n, CS_IC, C)
     for r in range(6):
-        x = y[r]
-        for s in range(6):
-            x += (cw[n, CS_BC + 6 * r + s] * (Sd[s] + Sd[s])
-                  - cw[n, CS_IC + 6 * r + s] * C[s])
-        dw[j, DW_Y + r] = x
+        dw[j, DW_Y + r] = y[r] + (bs[r] + bs[r]) - ic[r]
     Mt = rot_t(M, S[0], S[1], S[2])
     a = cross(nw[0], nw[1], nw[2], S[0], S[1], S[2])
     b = cross(fw[0], fw[1], fw[2], S[3], S[4], S[5])
@@ -287,7 +338,7 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
       = F1_a . Sdot_b + F2_a . S_b
     - a ancestor of b: C[a, b] = S_a^T (IC_b Sdot_b + BC_b S_b) = S_a . G_b
 
-    Two O(nb) passes and 18 multiply-adds per ancestor pair, against the n
+    Two O(nb) passes and 15 multiply-adds per ancestor pair, against the n
     recursions of ``coriolis_matrix_columns``; the same C up to round-off.
     ``cw`` is an (nb + 1, CW_WIDTH) workspace.  Returns -1 or OVERFLOW.
     """
@@ -311,9 +362,6 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
         f20 = cw[a, CW_F2]
         f21 = cw[a, CW_F2 + 1]
         f22 = cw[a, CW_F2 + 2]
-        f23 = cw[a, CW_F2 + 3]
-        f24 = cw[a, CW_F2 + 4]
-        f25 = cw[a, CW_F2 + 5]
         # row a left of the diagonal: b = a, then a's ancestors (on a
         # chain every b < a, in order, row a written contiguously)
         b = a if tree else 0
@@ -322,8 +370,7 @@ def coriolis_matrix_composite(links, frames, q, qd, ws, cw, C):
                   + f12 * cw[b, CW_SD + 2] + f13 * cw[b, CW_SD + 3]
                   + f14 * cw[b, CW_SD + 4] + f15 * cw[b, CW_SD + 5])
                  + (f20 * cw[b, CW_S] + f21 * cw[b, CW_S + 1]
-                    + f22 * cw[b, CW_S + 2] + f23 * cw[b, CW_S + 3]
-                    + f24 * cw[b, CW_S + 4] + f25 * cw[b, CW_S + 5]))
+                    + f22 * cw[b, CW_S + 2]))
             put_pair(links, C, a, b, x, mimic)
             check = check + zero * x
             if tree:

@@ -226,7 +226,7 @@ def rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
     check = zero
     for a in range(nb):
         F1 = vec6(cw, a, CW_F1)
-        F2 = vec6(cw, a, CW_F2)
+        F2 = load3(cw, a, CW_F2)       # its linear part is zero
         G = vec6(cw, a, CW_G)
         Y = vec6(dw, a, DW_Y)
         U = load3(dw, a, DW_U)
@@ -234,9 +234,11 @@ def rnea_derivatives(links, frames, q, qd, qdd, wrench, fext, wext,
         while b >= 0:      # b = a, then a's ancestors
             Sb = vec6(cw, b, CW_S)
             Sd = vec6(cw, b, CW_SD)
-            x = (dot6(F2, Sd) + dot6(F2, Sd) - dot6(F1, vec6(dw, b, DW_C))
+            f = F2[0] * Sd[0] + F2[1] * Sd[1] + F2[2] * Sd[2]
+            x = (f + f - dot6(F1, vec6(dw, b, DW_C))
                  + (U[0] * Sb[0] + U[1] * Sb[1] + U[2] * Sb[2]))
-            y = dot6(F1, Sd) + dot6(F2, Sb)
+            y = dot6(F1, Sd) + (F2[0] * Sb[0] + F2[1] * Sb[1]
+                                + F2[2] * Sb[2])
             put_pair(links, DQ, a, b, x, mimic)
             put_pair(links, DV, a, b, y + y, mimic)
             check = check + zero * (x + y)

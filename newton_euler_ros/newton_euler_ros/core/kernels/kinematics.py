@@ -245,13 +245,13 @@ def link_inertia(links, j):
 
 
 @njit(cache=True, inline='always')
-def body_inertia(links, j, R, o, out, row, col):
+def inertia_parts(links, j, R, o):
     """
-    Write link j's spatial inertia into ``out[row, col:col + 36]``.
+    Return link j's J (row-major 3x3), h = m c and m about a point o.
 
-    About the origin o of the frame whose rotation (to link j's kernel
-    frame axes) is R: the link's centre of mass is o + R c and its
-    rotational inertia R I_c R^T.  Blocks [[I_o, m [c]], [m [c]^T, m 1]].
+    The frame's rotation (to link j's kernel frame axes) is R: the link's
+    centre of mass is c = o + R c_j and J = R I_c R^T + m ([c]^T [c]),
+    its rotational inertia about o.
     """
     m = links[j, L_MASS]
     c = rot(R, links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2])
@@ -259,15 +259,30 @@ def body_inertia(links, j, R, o, out, row, col):
     Ic = matmul(matmul(R, link_inertia(links, j)), transpose(R))
     mc = (m * c[0], m * c[1], m * c[2])
     cc = c[0] * mc[0] + c[1] * mc[1] + c[2] * mc[2]
+    J = (Ic[0] - mc[0] * c[0] + cc, Ic[1] - mc[0] * c[1],
+         Ic[2] - mc[0] * c[2], Ic[3] - mc[1] * c[0],
+         Ic[4] - mc[1] * c[1] + cc, Ic[5] - mc[1] * c[2],
+         Ic[6] - mc[2] * c[0], Ic[7] - mc[2] * c[1],
+         Ic[8] - mc[2] * c[2] + cc)
+    return J, mc, m
+
+
+@njit(cache=True, inline='always')
+def body_inertia(links, j, R, o, out, row, col):
+    """
+    Write link j's spatial inertia into ``out[row, col:col + 36]``.
+
+    About the origin o of the frame whose rotation (to link j's kernel
+    frame axes) is R (:func:`inertia_parts`): blocks
+    [[J, [h]], [[h]^T, m 1]].
+    """
+    J, mc, m = inertia_parts(links, j, R, o)
     zero = m - m
     for r in range(3):
         for s in range(3):
-            v = Ic[3 * r + s] - mc[r] * c[s]
-            if r == s:
-                v = v + cc
-            out[row, col + 6 * r + s] = v
+            out[row, col + 6 * r + s] = J[3 * r + s]
             out[row, col + 6 * (r + 3) + s + 3] = m if r == s else zero
-    # m [c] (top right) and its transpose (bottom left)
+    # [h] (top right) and its transpose (bottom left)
     X = (zero, -mc[2], mc[1], mc[2], zero, -mc[0], -mc[1], mc[0], zero)
     for r in range(3):
         for s in range(3):

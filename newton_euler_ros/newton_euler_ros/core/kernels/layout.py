@@ -208,19 +208,22 @@ CW = Columns('CW_', 'cw row')
 CW_S = CW.add('s', 6, 'motion subspace of joint j, frame 0 at its origin')
 CW_SD = CW.add('sd', 6, 'its rate, V_j x S_j')
 CW_F1 = CW.add('f1', 6, 'IC_j S_j')
-CW_F2 = CW.add('f2', 6, 'BC_j^T S_j')
+CW_F2 = CW.add('f2', 3, 'BC_j^T S_j: its angular part (the linear is zero)')
 CW_G = CW.add('g', 6, 'IC_j Sdot_j + BC_j S_j')
 CW_RW = CW.add('rw', 9, 'rotation of kernel frame j in frame 0')
 CW_OW = CW.add('ow', 3, 'origin of kernel frame j in frame 0')
 CW_V = CW.add('v', 6, 'spatial velocity of link j')
-CW_I = CW.add('i', 36, 'spatial inertia of link j, frame 0 about its origin')
-CW_ICA = CW.add('ica', 36, 'composite inertia the children of a branch '
+CW_I = CW.add('i', 10, 'spatial inertia of link j, frame 0 about its origin '
+              '(``coriolis.inertia_times``): J (xx, xy, xz, yy, yz, zz), '
+              'h = m c, m')
+CW_ICA = CW.add('ica', 10, 'composite inertia the children of a branch '
                 'point carried back to it (summed)')
-CW_BCA = CW.add('bca', 36, 'the same of their composite Coriolis matrices')
+CW_BCA = CW.add('bca', 12, 'the same of their composite Coriolis matrices')
 CW_WIDTH = CW.width
 CS = Columns('CS_', 'cw scratch row')
-CS_IC = CS.add('ic', 36, 'composite inertia')
-CS_BC = CS.add('bc', 36, 'composite Coriolis matrix')
+CS_IC = CS.add('ic', 10, 'composite inertia, as ``CW_I``')
+CS_BC = CS.add('bc', 12, 'composite Coriolis matrix [[P, 0], [-[h_f], 0]]: '
+               'P (9, row-major), then h_f')
 CS_H = CS.add('h', 6, 'I_j V_j')
 
 # ---- ``dw``: the derivative workspace (n + 1 rows) -------------------------
