@@ -29,25 +29,27 @@ def cholesky_solve(A, b, L, x):
     in place (each entry of A is read before its L entry overwrites it,
     and b[i] before x[i]); the observer's damped solve uses that.
     """
-    bad = cholesky_factor(A, L)
+    n = A.shape[0]
+    bad = cholesky_factor(A, L, 0, n)
     if bad >= 0:
         return bad
-    cholesky_solve_factored(L, b, x)
+    cholesky_solve_factored(L, b, x, 0, n)
     return -1
 
 
 @njit(cache=True, inline='always')
-def cholesky_factor(A, L):
+def cholesky_factor(A, L, lo, hi):
     """
     Write the lower Cholesky factor of A into L (A = L L^T).
 
-    Returns -1, or the first pivot that is not positive.  L may be A.
+    Of the block A[lo:hi, lo:hi] alone (the whole matrix: 0, n), into the
+    same block of L.  Returns -1, or the first pivot that is not positive
+    (its index in A).  L may be A.
     """
-    n = A.shape[0]
-    for i in range(n):
-        for k in range(i + 1):
+    for i in range(lo, hi):
+        for k in range(lo, i + 1):
             acc = A[i, k]
-            for m in range(k):
+            for m in range(lo, k):
                 acc -= L[i, m] * L[k, m]
             if i == k:
                 if not acc > 0:     # an int literal: exact in any dtype
@@ -59,25 +61,26 @@ def cholesky_factor(A, L):
 
 
 @njit(cache=True, inline='always')
-def cholesky_solve_factored(L, b, x):
-    """Solve L L^T x = b (x may be b)."""
-    n = L.shape[0]
-    for i in range(n):
+def cholesky_solve_factored(L, b, x, lo, hi):
+    """Solve L L^T x = b (x may be b) on the block lo..hi-1 (0, n: all)."""
+    for i in range(lo, hi):
         acc = b[i]
-        for m in range(i):
+        for m in range(lo, i):
             acc -= L[i, m] * x[m]
         x[i] = acc / L[i, i]
-    for i in range(n - 1, -1, -1):
+    for i in range(hi - 1, lo - 1, -1):
         acc = x[i]
-        for m in range(i + 1, n):
+        for m in range(i + 1, hi):
             acc -= L[m, i] * x[m]
         x[i] = acc / L[i, i]
 
 
 @njit(cache=True, inline='always')
-def cholesky_inverse(L, X, rd, one):
+def cholesky_inverse(L, X, rd, one, lo, hi):
     """
     Write (L L^T)^-1 into X (not L), L from :func:`cholesky_factor`.
+
+    Of the block lo..hi-1 alone (0, n: all), into the same block of X.
 
     L^-1 goes into X's lower triangle, then row i of L^-T L^-1 (entry
     (i, j), j <= i: the sum over m >= i of L^-1[m, i] L^-1[m, j]) into
@@ -86,25 +89,24 @@ def cholesky_inverse(L, X, rd, one):
     divisions (``rd``, n scratch: the reciprocal pivots), against n^3
     and n^2 for n solves of unit vectors.  ``one``: 1 in L's type.
     """
-    n = L.shape[0]
-    for i in range(n):
+    for i in range(lo, hi):
         rd[i] = one / L[i, i]
-    for j in range(n):              # L^-1, column by column
+    for j in range(lo, hi):         # L^-1, column by column
         X[j, j] = rd[j]
-        for i in range(j + 1, n):
+        for i in range(j + 1, hi):
             acc = -L[i, j] * X[j, j]
             for m in range(j + 1, i):
                 acc -= L[i, m] * X[m, j]
             X[i, j] = acc * rd[i]
-    for i in range(n):              # L^-T L^-1, row i into column i
-        for j in range(i + 1):
+    for i in range(lo, hi):         # L^-T L^-1, row i into column i
+        for j in range(lo, i + 1):
             acc = X[i, i] * X[i, j]
-            for m in range(i + 1, n):
+            for m in range(i + 1, hi):
                 acc += X[m, i] * X[m, j]
             if j < i:
                 X[j, i] = acc
             else:
                 X[i, i] = acc
-    for i in range(n):
-        for j in range(i):
+    for i in range(lo, hi):
+        for j in range(lo, i):
             X[i, j] = X[j, i]

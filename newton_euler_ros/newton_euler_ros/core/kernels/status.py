@@ -60,6 +60,16 @@ def check_finite(q, qd, qdd, wrench):
     return -1
 
 
+@njit(cache=True, inline='always')
+def block_status(X, lo, hi):
+    """Return -1 when X[lo:hi, lo:hi] is finite, else OVERFLOW."""
+    for i in range(lo, hi):
+        for k in range(lo, hi):
+            if not math.isfinite(X[i, k]):
+                return OVERFLOW
+    return -1
+
+
 @njit(cache=True)
 def matrix_status(X):
     """Return -1 when every entry is finite, else OVERFLOW."""
