@@ -44,19 +44,14 @@ def inertia_times(arr, row, col, x):
     With J its rotational inertia about the origin, h = m c and m:
     I [w; v] = [J w + h x v; m v - h x w], 24 multiplications.
     """
-    Jxx = arr[row, col]
-    Jxy = arr[row, col + 1]
-    Jxz = arr[row, col + 2]
-    Jyy = arr[row, col + 3]
-    Jyz = arr[row, col + 4]
-    Jzz = arr[row, col + 5]
-    h = (arr[row, col + 6], arr[row, col + 7], arr[row, col + 8])
+    J = vec6(arr, row, col)     # xx, xy, xz, yy, yz, zz
+    h = load3(arr, row, col + 6)
     m = arr[row, col + 9]
     a = cross(h[0], h[1], h[2], x[3], x[4], x[5])
     b = cross(h[0], h[1], h[2], x[0], x[1], x[2])
-    return (Jxx * x[0] + Jxy * x[1] + Jxz * x[2] + a[0],
-            Jxy * x[0] + Jyy * x[1] + Jyz * x[2] + a[1],
-            Jxz * x[0] + Jyz * x[1] + Jzz * x[2] + a[2],
+    return (J[0] * x[0] + J[1] * x[1] + J[2] * x[2] + a[0],
+            J[1] * x[0] + J[3] * x[1] + J[4] * x[2] + a[1],
+            J[2] * x[0] + J[4] * x[1] + J[5] * x[2] + a[2],
             m * x[3] - b[0], m * x[4] - b[1], m * x[5] - b[2])
 
 
