@@ -63,7 +63,8 @@ URDF = """<?xml version="1.0"?>
 </robot>
 """
 # the files whose functions numba compiles (and caches)
-COMPILED = ('core/kernels/', 'core/observer/', 'ident/excite.py')
+COMPILED = ('core/kernels/', 'core/observer/', 'ident/excite.py',
+            'ident/signals.py')
 
 
 def sources_digest():
@@ -176,7 +177,9 @@ def precompile(log=print):
     for model in models:
         _exercise(model)
     from .ident.excite import precompile as excite_precompile
+    from .ident.signals import precompile as signals_precompile
     excite_precompile()
+    signals_precompile()
     return time.monotonic() - start
 
 
