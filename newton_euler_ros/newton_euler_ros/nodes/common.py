@@ -204,7 +204,8 @@ def _warn_foreign_params_files(node):
     for path in params_files(_PROCESS_ARGS):
         try:
             with open(path, encoding='utf-8') as fh:
-                data = yaml.safe_load(fh)
+                loader = getattr(yaml, 'CSafeLoader', yaml.SafeLoader)
+                data = yaml.load(fh, Loader=loader)
         except (OSError, yaml.YAMLError, UnicodeDecodeError):
             continue            # rcl has already said what is wrong
         sections = params_file_sections(data)
