@@ -69,6 +69,12 @@ def domain_id(offset):
 NodeProcess = ChildProcess
 
 
+# tests that read the node's input counters (next_counters) ask for them
+# ten times a second rather than once (the default): each read waits for
+# the next message
+FAST_DIAGNOSTICS = ('-p', 'diagnostics_period:=0.1')
+
+
 def id_node_cmd(params='puma560.yaml', *extra):
     """
     Command line of inverse_dynamics_node, as a user starts it.

@@ -37,8 +37,9 @@ from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (coriolis_matrix, gravity_torques,  # noqa: E402
                                    inverse_dynamics, load_robot,
                                    mass_matrix)
-from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe, ros_env, wrench)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, joint_state, NodeProcess, Probe, ros_env,
+                         wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -51,7 +52,7 @@ TIMEOUT = 1.0   # wrench.timeout for this node, seconds
 
 
 def node_cmd(*extra):
-    return id_node_cmd('puma560.yaml', *extra)
+    return id_node_cmd('puma560.yaml', *FAST_DIAGNOSTICS, *extra)
 
 
 @pytest.fixture(scope='module')

@@ -27,8 +27,8 @@ pytest.importorskip('rclpy')
 from diagnostic_msgs.msg import DiagnosticArray  # noqa: E402, I100
 from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from rclpy.qos import QoSProfile  # noqa: E402
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, NodeProcess, Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 
 pytestmark = [pytest.mark.ros, pytest.mark.slow]
@@ -39,7 +39,7 @@ FLOOD_S = 15.0
 
 
 def node_cmd():
-    return id_node_cmd('puma560.yaml')
+    return id_node_cmd('puma560.yaml', *FAST_DIAGNOSTICS)
 
 
 @pytest.fixture(scope='module')

@@ -39,8 +39,8 @@ from newton_euler_ros.core import (end_effector_pose,  # noqa: E402
 from rcl_interfaces.srv import (SetParameters,  # noqa: E402
                                 SetParametersAtomically)
 from rclpy.parameter import Parameter  # noqa: E402
-from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, joint_state, NodeProcess, Probe)
 from sensor_msgs.msg import JointState  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
                                  JointTrajectoryPoint)
@@ -52,7 +52,7 @@ NODE = '/inverse_dynamics_node'
 
 def node_cmd(mode, *extra):
     return id_node_cmd(f'puma560_{mode}.yaml', '-p', 'log_throttle:=0.01',
-                       *extra)
+                       *FAST_DIAGNOSTICS, *extra)
 
 
 @pytest.fixture(scope='module')

@@ -38,8 +38,8 @@ from newton_euler_interfaces.srv import ComputeDynamics  # noqa: E402
 from newton_euler_ros.core import (DynamicsInputError,  # noqa: E402
                                    inverse_dynamics, load_robot)
 from rclpy.qos import QoSProfile, ReliabilityPolicy  # noqa: E402
-from ros_harness import (domain_id, id_node_cmd, NodeProcess,  # noqa: E402
-                         Probe, wrench)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray  # noqa: E402
 
@@ -66,7 +66,7 @@ FRAMES_BAD = ['', 'world', 'base_link ', 'BASE_LINK', 'tool0/', '/tool0',
 
 
 def node_cmd(*extra):
-    return id_node_cmd('puma560.yaml', *extra)
+    return id_node_cmd('puma560.yaml', *FAST_DIAGNOSTICS, *extra)
 
 
 def finite(values):

@@ -40,8 +40,8 @@ from newton_euler_ros.core.model import rpy_matrix  # noqa: E402
 from newton_euler_ros.core.urdf import load_urdf, model_to_urdf  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
-from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe, wrench)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, joint_state, NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import String  # noqa: E402
 
@@ -60,7 +60,7 @@ def node_cmd(*extra):
     # the bundled parameter file for URDF robots, as the README runs it
     return id_node_cmd('urdf.yaml', '-p', 'base_link:=base_link',
                        '-p', 'tip_link:=tool0', '-p', 'log_throttle:=0.01',
-                       *extra)
+                       *FAST_DIAGNOSTICS, *extra)
 
 
 def with_sensor(urdf_text):

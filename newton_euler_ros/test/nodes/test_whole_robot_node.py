@@ -66,8 +66,8 @@ from rcl_interfaces.srv import SetParametersAtomically  # noqa: E402
 from rclpy.parameter import Parameter  # noqa: E402
 from rclpy.qos import (DurabilityPolicy, QoSProfile,  # noqa: E402
                        ReliabilityPolicy)
-from ros_harness import (domain_id, id_node_cmd, joint_state,  # noqa: E402
-                         NodeProcess, Probe, wrench)
+from ros_harness import (domain_id, FAST_DIAGNOSTICS,  # noqa: E402
+                         id_node_cmd, joint_state, NodeProcess, Probe, wrench)
 from sensor_msgs.msg import JointState  # noqa: E402
 from std_msgs.msg import Float64MultiArray, String  # noqa: E402
 from trajectory_msgs.msg import (JointTrajectory,  # noqa: E402
@@ -122,7 +122,7 @@ class Robot:
             '-p', f'observer.end_effectors:=[{", ".join(WRISTS)}]',
             # a link's wrench needs a contact on its own joints
             '-p', 'observer.thresholds:=[1.0]',
-            '-p', 'log_throttle:=0.01'),
+            '-p', 'log_throttle:=0.01', *FAST_DIAGNOSTICS),
             self.domain, os.path.join(tmp, 'node.log'))
         self.torques = self.probe.collect(JointState, f'{NODE}/torques')
         self.commands = self.probe.collect(Float64MultiArray,
