@@ -224,12 +224,23 @@ class Probe:
 
     def next_counters(self, diagnostics, timeout=5.0):
         """
-        Return the node's input counters from the next diagnostics message.
+        Return the node's input counters from a message published from now.
 
         ``diagnostics`` is the list a ``collect(DiagnosticArray, ...)``
-        fills.
+        fills.  Messages waiting in the reader's queue (the probe did not
+        spin for a while) were published before this call: their stamps
+        say so, and they are passed over.  A node on a simulated clock
+        (stamps an hour or more before this clock's) gets the next message
+        taken, whatever its stamp.
         """
+        since = self.node.get_clock().now().nanoseconds
         count = len(diagnostics)
-        assert self.spin_until(lambda: len(diagnostics) > count, timeout)
-        return {kv.key: int(kv.value)
-                for kv in diagnostics[-1].status[0].values}
+
+        def fresh():
+            for msg in diagnostics[count:]:
+                t = msg.header.stamp.sec * 10**9 + msg.header.stamp.nanosec
+                if t >= since or since - t > 3600 * 10**9:
+                    return msg
+            return None
+        assert self.spin_until(lambda: fresh() is not None, timeout)
+        return {kv.key: int(kv.value) for kv in fresh().status[0].values}
