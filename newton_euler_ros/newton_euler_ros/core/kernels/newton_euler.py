@@ -82,13 +82,13 @@ def recursion(links, frames, qd, v, qdd, wrench, fext, gravity_on,
     branch point stores its state for its later children (``W_X``) and
     sums what they carry back (``W_ACC``).  The two passes are
     :func:`forward_pass` and :func:`backward_pass`; the workspace carries
-    each body's net force and moment from one to the other.  Within a pass
-    the per-body step is written inline in the loop: numba passes arrays
-    and tuples between functions at a cost (measured: 35% more per call
-    with the body steps as functions, inlined or not).  Cost: about 250
-    flops per body, O(nb).  Every vector of link
-    j is in kernel frame j, whose z axis is joint j's axis through its
-    origin.
+    each body's net force and moment from one to the other.  Each pass is
+    its per-body step in a loop (:func:`forward_step` after
+    :func:`forward_start`, :func:`backward_step` before
+    :func:`backward_carry`), the steps inlined into the loop by numba
+    (``inline='always'``).  Cost: about 250 flops per body, O(nb).
+    Every vector of link j is in kernel frame j, whose z axis is joint
+    j's axis through its origin.
 
     Parameters
     ----------
@@ -134,115 +134,128 @@ def forward_pass(links, frames, qd, v, qdd, gravity_on, velocity_on, ws):
     """
     Run the forward steps, base to tip: velocities and accelerations out.
 
-    The seed's eqs. (19)-(21), body by body: from the parent's angular
-    velocity ``w``, reference velocity ``r``, angular acceleration ``al``
-    and origin acceleration ``ae`` (its axes) to body j's (frame j axes),
-    then body j's net force m a_c (``W_F``) and net moment about its
-    centre of mass (``W_N``) into the workspace, which is all the backward
-    pass reads of it.  A branch point keeps its state for its later
-    children (``W_X``) and zeroes the sum they will carry back
-    (``W_ACC``).  Arguments as :func:`recursion`'s.
+    The state carried from body to body is ``(w, r, al, ae)``: angular
+    velocity, reference velocity, angular acceleration and the
+    acceleration of the origin, each a 3-tuple in the body's axes; the
+    base's is at rest, accelerating up at g.  Per body,
+    :func:`forward_start` picks the state it starts from and
+    :func:`forward_step` takes it on.  Arguments as :func:`recursion`'s.
     """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
-    half = frames[F_CONST, C_HALF]
     mimic = has_mimic(links, frames)
     # Gravity enters as an upward acceleration of the base: a_0 = -g.
     if gravity_on:
         a0 = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
     else:
         a0 = (zero, zero, zero)
-    ae = a0
-    w = (zero, zero, zero)
-    r = (zero, zero, zero)
-    al = (zero, zero, zero)
-
+    z3 = (zero, zero, zero)
+    state = (z3, z3, z3, a0)
     for j in range(nb):
-        par = parent(links, j)
-        if par != j - 1:        # a branch: start from the parent's state
-            if par < 0:
-                w = (zero, zero, zero)
-                r = (zero, zero, zero)
-                al = (zero, zero, zero)
-                ae = a0
-            else:
-                w = load3(ws, par, W_X)
-                r = load3(ws, par, W_X + 3)
-                al = load3(ws, par, W_X + 6)
-                ae = load3(ws, par, W_X + 9)
-        R, p = placement(links, frames, j, ws)
-        qddj = rate_or_zero(links, frames, qdd, j, mimic)
-        # acceleration of the new origin O_j, still in the parent's axes
-        t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
+        state = forward_start(links, ws, j, state, a0, z3)
+        state = forward_step(links, frames, qd, v, qdd, velocity_on, ws, j,
+                             mimic, state)
+
+
+@njit(cache=True, inline='always')
+def forward_start(links, ws, j, state, a0, z3):
+    """
+    Return body j's starting state: its parent's (a branch: as stored).
+
+    A root starts from the base's (``a0``; ``z3`` is the zero 3-tuple).
+    """
+    par = parent(links, j)
+    if par == j - 1:
+        return state
+    if par < 0:
+        return (z3, z3, z3, a0)
+    return (load3(ws, par, W_X), load3(ws, par, W_X + 3),
+            load3(ws, par, W_X + 6), load3(ws, par, W_X + 9))
+
+
+@njit(cache=True, inline='always')
+def forward_step(links, frames, qd, v, qdd, velocity_on, ws, j, mimic,
+                 state):
+    """
+    Take the state from body j's parent to body j; return body j's state.
+
+    The seed's eqs. (19)-(21): from the parent's ``(w, r, al, ae)`` (its
+    axes) to body j's (frame j axes), then body j's net force m a_c
+    (``W_F``) and net moment about its centre of mass (``W_N``) into the
+    workspace, which is all the backward pass reads of it.  A branch
+    point keeps its state for its later children (``W_X``) and zeroes the
+    sum they will carry back (``W_ACC``).
+    """
+    w, r, al, ae = state
+    zero = frames[F_CONST, C_ZERO]
+    half = frames[F_CONST, C_HALF]
+    R, p = placement(links, frames, j, ws)
+    qddj = rate_or_zero(links, frames, qdd, j, mimic)
+    t = cross(al[0], al[1], al[2], p[0], p[1], p[2])
+    ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+    if velocity_on:
+        t = cross(r[0], r[1], r[2], p[0], p[1], p[2])
+        t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
         ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
-        if velocity_on:
-            t = cross(r[0], r[1], r[2], p[0], p[1], p[2])
-            t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
-            ae = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
-        # rotate everything into frame j
-        ae = rot_t(R, ae[0], ae[1], ae[2])
-        al = rot_t(R, al[0], al[1], al[2])
-        is_revolute = revolute(links, frames, j)
-        if velocity_on:
-            # qd and v are read only here
-            qdj = rate_or_zero(links, frames, qd, j, mimic)
-            vj = rate_or_zero(links, frames, v, j, mimic)
-            w = rot_t(R, w[0], w[1], w[2])
-            r = rot_t(R, r[0], r[1], r[2])
-            if is_revolute:
-                # alpha_j = R^T alpha_{j-1} + z qdd + (r_{j-1} x z) qd_j
-                al = (al[0] + r[1] * qdj, al[1] - r[0] * qdj,
-                      al[2] + qddj)
-                w = (w[0], w[1], w[2] + qdj)
-                r = (r[0], r[1], r[2] + vj)
-            else:
-                # the sliding joint: z qdd + Coriolis 2 w x z qd (v == qd)
-                ae = (ae[0] + r[1] * qdj + w[1] * vj,
-                      ae[1] - r[0] * qdj - w[0] * vj,
-                      ae[2] + qddj)
-        elif is_revolute:
-            al = (al[0], al[1], al[2] + qddj)
+    ae = rot_t(R, ae[0], ae[1], ae[2])
+    al = rot_t(R, al[0], al[1], al[2])
+    is_revolute = revolute(links, frames, j)
+    if velocity_on:
+        qdj = rate_or_zero(links, frames, qd, j, mimic)
+        vj = rate_or_zero(links, frames, v, j, mimic)
+        w = rot_t(R, w[0], w[1], w[2])
+        r = rot_t(R, r[0], r[1], r[2])
+        if is_revolute:
+            al = (al[0] + r[1] * qdj, al[1] - r[0] * qdj,
+                  al[2] + qddj)
+            w = (w[0], w[1], w[2] + qdj)
+            r = (r[0], r[1], r[2] + vj)
         else:
-            ae = (ae[0], ae[1], ae[2] + qddj)
-        if branch_point(links, frames, j):
-            for k in range(3):
-                ws[j, W_X + k] = w[k]
-                ws[j, W_X + 3 + k] = r[k]
-                ws[j, W_X + 6 + k] = al[k]
-                ws[j, W_X + 9 + k] = ae[k]
-            for k in range(6):
-                ws[j, W_ACC + k] = zero
-        # acceleration of the centre of mass
-        c0 = links[j, L_COM]
-        c1 = links[j, L_COM + 1]
-        c2 = links[j, L_COM + 2]
-        t = cross(al[0], al[1], al[2], c0, c1, c2)
-        ac = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
-        if velocity_on:
-            t = cross(r[0], r[1], r[2], c0, c1, c2)
-            t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
-            ac = (ac[0] + t[0], ac[1] + t[1], ac[2] + t[2])
-        m = links[j, L_MASS]
-        ws[j, W_F] = m * ac[0]
-        ws[j, W_F + 1] = m * ac[1]
-        ws[j, W_F + 2] = m * ac[2]
-        # Euler's equation about the com
-        Ic = link_inertia(links, j)
-        Ia = rot(Ic, al[0], al[1], al[2])
-        Nn = Ia
-        if velocity_on:
-            Ir = rot(Ic, r[0], r[1], r[2])
-            Iw = rot(Ic, w[0], w[1], w[2])
-            t = cross(w[0], w[1], w[2], Ir[0], Ir[1], Ir[2])
-            t2 = cross(r[0], r[1], r[2], Iw[0], Iw[1], Iw[2])
-            wr = cross(w[0], w[1], w[2], r[0], r[1], r[2])
-            t3 = rot(Ic, wr[0], wr[1], wr[2])
-            Nn = (Ia[0] + half * ((t[0] + t2[0]) + t3[0]),
-                  Ia[1] + half * ((t[1] + t2[1]) + t3[1]),
-                  Ia[2] + half * ((t[2] + t2[2]) + t3[2]))
-        ws[j, W_N] = Nn[0]
-        ws[j, W_N + 1] = Nn[1]
-        ws[j, W_N + 2] = Nn[2]
+            ae = (ae[0] + r[1] * qdj + w[1] * vj,
+                  ae[1] - r[0] * qdj - w[0] * vj,
+                  ae[2] + qddj)
+    elif is_revolute:
+        al = (al[0], al[1], al[2] + qddj)
+    else:
+        ae = (ae[0], ae[1], ae[2] + qddj)
+    if branch_point(links, frames, j):
+        for k in range(3):
+            ws[j, W_X + k] = w[k]
+            ws[j, W_X + 3 + k] = r[k]
+            ws[j, W_X + 6 + k] = al[k]
+            ws[j, W_X + 9 + k] = ae[k]
+        for k in range(6):
+            ws[j, W_ACC + k] = zero
+    c0 = links[j, L_COM]
+    c1 = links[j, L_COM + 1]
+    c2 = links[j, L_COM + 2]
+    t = cross(al[0], al[1], al[2], c0, c1, c2)
+    ac = (ae[0] + t[0], ae[1] + t[1], ae[2] + t[2])
+    if velocity_on:
+        t = cross(r[0], r[1], r[2], c0, c1, c2)
+        t = cross(w[0], w[1], w[2], t[0], t[1], t[2])
+        ac = (ac[0] + t[0], ac[1] + t[1], ac[2] + t[2])
+    m = links[j, L_MASS]
+    ws[j, W_F] = m * ac[0]
+    ws[j, W_F + 1] = m * ac[1]
+    ws[j, W_F + 2] = m * ac[2]
+    Ic = link_inertia(links, j)
+    Ia = rot(Ic, al[0], al[1], al[2])
+    Nn = Ia
+    if velocity_on:
+        Ir = rot(Ic, r[0], r[1], r[2])
+        Iw = rot(Ic, w[0], w[1], w[2])
+        t = cross(w[0], w[1], w[2], Ir[0], Ir[1], Ir[2])
+        t2 = cross(r[0], r[1], r[2], Iw[0], Iw[1], Iw[2])
+        wr = cross(w[0], w[1], w[2], r[0], r[1], r[2])
+        t3 = rot(Ic, wr[0], wr[1], wr[2])
+        Nn = (Ia[0] + half * ((t[0] + t2[0]) + t3[0]),
+              Ia[1] + half * ((t[1] + t2[1]) + t3[1]),
+              Ia[2] + half * ((t[2] + t2[2]) + t3[2]))
+    ws[j, W_N] = Nn[0]
+    ws[j, W_N + 1] = Nn[1]
+    ws[j, W_N + 2] = Nn[2]
+    return (w, r, al, ae)
 
 
 @njit(cache=True, inline='always')
@@ -251,14 +264,9 @@ def backward_pass(links, frames, wrench, wrench_mode, fext, link_wrenches,
     """
     Run the backward steps, tip to base: forces and moments in, torques.
 
-    Body by body, the force and moment (about O_j, frame j axes) that body
-    j exerts on its children and its environment: what its children carry
-    back, the end effector's wrench at the tool's body (``wrench_mode``,
-    :func:`tip_wrench`), the links' own wrenches (``link_wrenches``,
-    :func:`link_wrench`), and its net force and moment from
-    :func:`forward_pass`; joint j takes the moment about (revolute) or the
-    force along (prismatic) its axis, and the rest goes to the parent.
-    Arguments as :func:`recursion`'s.
+    Per body, :func:`backward_step` gives the force and moment body j
+    exerts and its joint's torque, and :func:`backward_carry` hands them
+    to its parent.  Arguments as :func:`recursion`'s.
     """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
@@ -271,52 +279,80 @@ def backward_pass(links, frames, wrench, wrench_mode, fext, link_wrenches,
         for i in range(tau.shape[0]):
             tau[i] = zero
     tool = tool_body(frames) if wrench_mode != WRENCH_NONE else -2
-    f = (zero, zero, zero)
-    nm = (zero, zero, zero)
+    z3 = (zero, zero, zero)
+    f = z3
+    nm = z3
     for j in range(nb - 1, -1, -1):
-        if branch_point(links, frames, j):
-            f = (f[0] + ws[j, W_ACC], f[1] + ws[j, W_ACC + 1],
-                 f[2] + ws[j, W_ACC + 2])
-            nm = (nm[0] + ws[j, W_ACC + 3], nm[1] + ws[j, W_ACC + 4],
-                  nm[2] + ws[j, W_ACC + 5])
-        if wrench is not None:      # (compiled away when None)
-            if j == tool:
-                e = tip_wrench(frames, wrench, wrench_mode,
-                               frame_rotation(links, frames, ws, j))
-                nm = (nm[0] + e[0], nm[1] + e[1], nm[2] + e[2])
-                f = (f[0] + e[3], f[1] + e[4], f[2] + e[5])
-        if fext is not None:
-            if link_wrenches:
-                fe, ne = link_wrench(links, fext, j)
-                f = (f[0] + fe[0], f[1] + fe[1], f[2] + fe[2])
-                nm = (nm[0] + ne[0], nm[1] + ne[1], nm[2] + ne[2])
-        F0 = ws[j, W_F]
-        F1 = ws[j, W_F + 1]
-        F2 = ws[j, W_F + 2]
-        t = cross(links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2],
-                  F0, F1, F2)
-        nm = (nm[0] + t[0] + ws[j, W_N], nm[1] + t[1] + ws[j, W_N + 1],
-              nm[2] + t[2] + ws[j, W_N + 2])
-        f = (f[0] + F0, f[1] + F1, f[2] + F2)
-        # the joint takes the moment about (revolute) or the force along
-        # (prismatic) its axis z
-        if revolute(links, frames, j):
-            put(links, tau, j, nm[2], mimic)
-        else:
-            put(links, tau, j, f[2], mimic)
-        par = parent(links, j)
-        if par >= 0:
-            R, p = stored_placement(ws, j)
-            f, nm = force_to_parent(R, p, f, nm)
-            if par != j - 1:    # a branch: into the parent's sum
-                for k in range(3):
-                    ws[par, W_ACC + k] += f[k]
-                    ws[par, W_ACC + 3 + k] += nm[k]
-                f = (zero, zero, zero)
-                nm = (zero, zero, zero)
-        else:
-            f = (zero, zero, zero)
-            nm = (zero, zero, zero)
+        f, nm = backward_step(links, frames, wrench, wrench_mode, fext,
+                              link_wrenches, ws, tau, j, tool, mimic, f, nm)
+        f, nm = backward_carry(links, ws, j, f, nm, z3)
+
+
+@njit(cache=True, inline='always')
+def backward_step(links, frames, wrench, wrench_mode, fext, link_wrenches,
+                  ws, tau, j, tool, mimic, f, nm):
+    """
+    Return what body j exerts, ``(f, nm)``; put its joint's torque in tau.
+
+    ``f`` and ``nm`` come in as what its children carry back (a branch
+    point adds their sum, ``W_ACC``); then the end effector's wrench at
+    the tool's body (``wrench_mode``, :func:`tip_wrench`; ``tool`` is
+    that body), the links' own wrenches (``link_wrenches``,
+    :func:`link_wrench`) and its net force and moment from
+    :func:`forward_step`.  The force and the moment (about O_j, frame j
+    axes) are what body j exerts on its children and its environment;
+    joint j takes the moment about (revolute) or the force along
+    (prismatic) its axis.
+    """
+    if branch_point(links, frames, j):
+        f = (f[0] + ws[j, W_ACC], f[1] + ws[j, W_ACC + 1],
+             f[2] + ws[j, W_ACC + 2])
+        nm = (nm[0] + ws[j, W_ACC + 3], nm[1] + ws[j, W_ACC + 4],
+              nm[2] + ws[j, W_ACC + 5])
+    if wrench is not None:      # (compiled away when None)
+        if j == tool:
+            e = tip_wrench(frames, wrench, wrench_mode,
+                           frame_rotation(links, frames, ws, j))
+            nm = (nm[0] + e[0], nm[1] + e[1], nm[2] + e[2])
+            f = (f[0] + e[3], f[1] + e[4], f[2] + e[5])
+    if fext is not None:
+        if link_wrenches:
+            fe, ne = link_wrench(links, fext, j)
+            f = (f[0] + fe[0], f[1] + fe[1], f[2] + fe[2])
+            nm = (nm[0] + ne[0], nm[1] + ne[1], nm[2] + ne[2])
+    F0 = ws[j, W_F]
+    F1 = ws[j, W_F + 1]
+    F2 = ws[j, W_F + 2]
+    t = cross(links[j, L_COM], links[j, L_COM + 1], links[j, L_COM + 2],
+              F0, F1, F2)
+    nm = (nm[0] + t[0] + ws[j, W_N], nm[1] + t[1] + ws[j, W_N + 1],
+          nm[2] + t[2] + ws[j, W_N + 2])
+    f = (f[0] + F0, f[1] + F1, f[2] + F2)
+    if revolute(links, frames, j):
+        put(links, tau, j, nm[2], mimic)
+    else:
+        put(links, tau, j, f[2], mimic)
+    return f, nm
+
+
+@njit(cache=True, inline='always')
+def backward_carry(links, ws, j, f, nm, z3):
+    """
+    Return what body j hands its parent, in the parent's frame.
+
+    A root hands on nothing, a branch adds into its parent's ``W_ACC``.
+    """
+    par = parent(links, j)
+    if par < 0:
+        return z3, z3
+    R, p = stored_placement(ws, j)
+    f, nm = force_to_parent(R, p, f, nm)
+    if par != j - 1:    # a branch: into the parent's sum
+        for k in range(3):
+            ws[par, W_ACC + k] += f[k]
+            ws[par, W_ACC + 3 + k] += nm[k]
+        return z3, z3
+    return f, nm
 
 
 @njit(cache=True, inline='always')
