@@ -18,10 +18,11 @@ Per-call cost of two checkouts side by side (did a change cost time).
 
 BEFORE is another checkout of the repository (``git worktree add
 build/before COMMIT``).  Each round times the public single-state calls
-(τ, D, C, g and forward dynamics on the Puma, the Panda and a random
-100-link chain, minimum of 60 × 2000 calls; 15 × 200 for the 100-link
-chain) and the batch calls (τ, D and forward dynamics of 100 Panda
-states) once in a process importing BEFORE's package and once in one
+(τ, D, C, g, forward dynamics, the regressor Y and the momentum
+observer's terms on the Puma, the Panda, a random 100-link chain and
+Centauro's whole tree, minimum of 60 × 2000 calls; 15 × 200 for the
+100-link chain and Centauro) and the batch calls (τ, D and forward
+dynamics of 100 Panda states) once in a process importing BEFORE's package and once in one
 importing this one, alternately, so both see the same machine; the
 table keeps each figure's minimum over the rounds.  Each checkout
 compiles into a numba cache of its own (under ``build/``).
@@ -35,14 +36,25 @@ import sys
 # run in the child: prints {"robot op": ns}
 CHILD = r"""
 import json, timeit
+import warnings
 import numpy as np
 import newton_euler_ros.core as c
+from newton_euler_ros.core import kernels as K
 from newton_euler_tools.accuracy.chains import random_chain
+from newton_euler_tools.peers import example_robot_urdf
 out = {}
-for name in ('puma560', 'panda', 'chain100'):
-    arm = random_chain(100, seed=3) if name == 'chain100' else \
-        c.load_robot(name)
-    number, repeat = (200, 15) if name == 'chain100' else (2000, 60)
+for name in ('puma560', 'panda', 'chain100', 'centauro'):
+    if name == 'chain100':
+        arm = random_chain(100, seed=3)
+    elif name == 'centauro':
+        with warnings.catch_warnings():
+            warnings.simplefilter('ignore')
+            arm = c.load_urdf(example_robot_urdf(
+                'centauro_description/urdf/centauro.urdf'))
+    else:
+        arm = c.load_robot(name)
+    number, repeat = (2000, 60) if name in ('puma560', 'panda') else \
+        (200, 15)
     ws = c.Workspace(arm)
     q, qd, qdd = np.random.default_rng(1).uniform(-1, 1, (3, arm.n))
     tau = c.inverse_dynamics(arm, q, qd, qdd, ws=ws)
@@ -52,7 +64,11 @@ for name in ('puma560', 'panda', 'chain100'):
         'C': lambda: c.coriolis_matrix(arm, q, qd, ws=ws),
         'g': lambda: c.gravity_torques(arm, q, ws=ws),
         'FD': lambda: c.forward_dynamics(arm, q, qd, tau, ws=ws),
+        'Y': lambda: c.regressor(arm, q, qd, qdd),
+        'terms': lambda: K.run_momentum_terms(arm.packed, q, qd, ws.ws,
+                                              ws.cw, terms),
     }
+    terms = np.empty((3, arm.n))
     if name == 'panda':
         Q, QD, QDD = np.random.default_rng(2).uniform(-1, 1, (3, 100, arm.n))
         TAU = c.inverse_dynamics_batch(arm, Q, QD, QDD, ws=ws)

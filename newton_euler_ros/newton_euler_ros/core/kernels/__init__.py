@@ -23,8 +23,9 @@ file                   what it holds
                        force and moment) and the backward pass (tip to
                        base: the force balance, the joint torques), with
                        the tip wrench beside them; g(q); D and C column by
-                       column from unit inputs; D qd, C^T qd and g in one
-                       recursion (the momentum observer's terms)
+                       column from unit inputs
+``momentum.py``        D qd, C^T qd and g in one recursion (the momentum
+                       observer's terms)
 ``crba.py``            D(q) by the composite-rigid-body algorithm
 ``coriolis.py``        C(q, qd) in O(n^2) from composite bodies
 ``aba.py``             qdd by the articulated-body algorithm
@@ -92,8 +93,9 @@ from .layout import (A_A, A_C, A_D, A_IA, A_PA, A_U, A_UU, A_V, A_WIDTH, AW,
                      T_BRANCHED, T_NQ, T_TOOL, TREE, VELOCITY, W_ACC, W_CT,
                      W_DD, W_F, W_N, W_P, W_R, W_ST, W_WIDTH, W_X, WRENCH_BASE,
                      WRENCH_BITS, WRENCH_EE, WRENCH_NONE, WRENCH_SHIFT, WS)
+from .momentum import momentum_terms
 from .newton_euler import (coriolis_matrix_columns, mass_matrix_columns,
-                           momentum_terms, recursion, unit_columns)
+                           recursion, unit_columns)
 from .status import check_finite, first_nonfinite, round_into
 
 __all__ = [
@@ -127,8 +129,9 @@ __all__ += sorted(RUN)
 
 # the kernel files in the order they import each other
 MODULES = ('_jit', 'layout', 'spatial', 'status', 'cholesky', 'kinematics',
-           'newton_euler', 'crba', 'coriolis', 'aba', 'derivatives',
-           'regressor', 'entry', 'entries', 'entries_derivatives')
+           'newton_euler', 'momentum', 'crba', 'coriolis', 'aba',
+           'derivatives', 'regressor', 'entry', 'entries',
+           'entries_derivatives')
 _DIR = os.path.dirname(os.path.abspath(__file__))
 
 

@@ -70,10 +70,16 @@ def mass_matrix_crba(links, frames, q, ws, D):
     add their entries to their leads' (D = G^T D_b G).
 
     Returns -1, or OVERFLOW when an entry is not finite (as ``mass_matrix_columns``).
+
+    The steps, per joint from the tip (Pinocchio's CrbaBackwardStep):
+    :func:`composite_start` takes the sum a branch point's later children
+    carried back, :func:`composite_add_link` adds link i,
+    :func:`support_column` fills column i from the unit-rate wrench, and
+    :func:`composite_to_parent` carries composite i into its parent's
+    frame.  The composite, ``(Mc, h, Io)``, is carried in registers.
     """
     nb = links.shape[0]
     zero = frames[F_CONST, C_ZERO]
-    half = frames[F_CONST, C_HALF]
     mimic = has_mimic(links, frames)
     joint_trig(links, frames, q, ws)
     for j in range(nb):
@@ -83,97 +89,152 @@ def mass_matrix_crba(links, frames, q, ws, D):
                 ws[j, W_ACC + k] = zero
     if mimic or branched(frames):
         zero_matrix(frames, D)
-    Mc = zero
-    h = (zero, zero, zero)
-    Io = (zero, zero, zero, zero, zero, zero)
+    z3 = (zero, zero, zero)
+    z6 = (zero, zero, zero, zero, zero, zero)
+    composite = (zero, z3, z6)
     # zero times each entry: stays zero unless one is inf or nan (cheaper
     # than a pass over all n^2 entries, most of them zero on a tree)
     check = zero
     for i in range(nb - 1, -1, -1):
-        if branch_point(links, frames, i):      # the later children's
-            a = W_ACC
-            Mc = Mc + ws[i, a]
-            h = (h[0] + ws[i, a + 1], h[1] + ws[i, a + 2],
-                 h[2] + ws[i, a + 3])
-            Io = (Io[0] + ws[i, a + 4], Io[1] + ws[i, a + 5],
-                  Io[2] + ws[i, a + 6], Io[3] + ws[i, a + 7],
-                  Io[4] + ws[i, a + 8], Io[5] + ws[i, a + 9])
-        # ---- add link i to the composite (frame i, about O_i) ----
-        m = links[i, L_MASS]
-        c0 = links[i, L_COM]
-        c1 = links[i, L_COM + 1]
-        c2 = links[i, L_COM + 2]
-        mc0 = m * c0
-        mc1 = m * c1
-        mc2 = m * c2
-        k = L_INERTIA
-        Mc = Mc + m
-        h = (h[0] + mc0, h[1] + mc1, h[2] + mc2)
-        Io = (Io[0] + links[i, k] + (mc1 * c1 + mc2 * c2),
-              Io[1] + links[i, k + 4] + (mc0 * c0 + mc2 * c2),
-              Io[2] + links[i, k + 8] + (mc0 * c0 + mc1 * c1),
-              Io[3] + half * (links[i, k + 1] + links[i, k + 3]) - mc0 * c1,
-              Io[4] + half * (links[i, k + 5] + links[i, k + 7]) - mc1 * c2,
-              Io[5] + half * (links[i, k + 2] + links[i, k + 6]) - mc0 * c2)
-        # ---- wrench on the composite for a unit rate of joint i ----
-        is_revolute = revolute(links, frames, i)
-        if is_revolute:
-            F = (-h[1], h[0], zero)
-            N = (Io[5], Io[4], Io[2])
-            put_pair(links, D, i, i, N[2], mimic)
-            check = check + zero * N[2]
-        else:
-            F = (zero, zero, Mc)
-            N = (h[1], -h[0], zero)
-            put_pair(links, D, i, i, F[2], mimic)
-            check = check + zero * F[2]
-        # ---- carry it to the base, joint by joint up the support ----
-        k = i
-        j = parent(links, i)
-        while j >= 0:
-            R, p = stored_placement(ws, k)
-            F, N = force_to_parent(R, p, F, N)
-            if revolute(links, frames, j):
-                x = N[2]
-            else:
-                x = F[2]
-            put_pair(links, D, j, i, x, mimic)
-            put_pair(links, D, i, j, x, mimic)
-            check = check + zero * x
-            k = j
-            j = parent(links, j)
-        # ---- the composite in its parent's frame, about its origin ----
-        par = parent(links, i)
-        if par >= 0:
-            R, p = stored_placement(ws, i)
-            hr = rot(R, h[0], h[1], h[2])
-            Ir = sym_rotate(R, Io)
-            hMc = half * Mc
-            gp = (hr[0] + hMc * p[0], hr[1] + hMc * p[1], hr[2] + hMc * p[2])
-            gp0 = gp[0] * p[0]
-            gp1 = gp[1] * p[1]
-            gp2 = gp[2] * p[2]
-            Io = (Ir[0] + ((gp1 + gp2) + (gp1 + gp2)),
-                  Ir[1] + ((gp0 + gp2) + (gp0 + gp2)),
-                  Ir[2] + ((gp0 + gp1) + (gp0 + gp1)),
-                  Ir[3] - (gp[0] * p[1] + gp[1] * p[0]),
-                  Ir[4] - (gp[1] * p[2] + gp[2] * p[1]),
-                  Ir[5] - (gp[0] * p[2] + gp[2] * p[0]))
-            h = (hr[0] + Mc * p[0], hr[1] + Mc * p[1], hr[2] + Mc * p[2])
-            if par != i - 1:    # a branch: into the parent's sum
-                a = W_ACC
-                ws[par, a] += Mc
-                for k in range(3):
-                    ws[par, a + 1 + k] += h[k]
-                for k in range(6):
-                    ws[par, a + 4 + k] += Io[k]
-                Mc = zero
-                h = (zero, zero, zero)
-                Io = (zero, zero, zero, zero, zero, zero)
-        else:
-            Mc = zero
-            h = (zero, zero, zero)
-            Io = (zero, zero, zero, zero, zero, zero)
+        composite = composite_start(links, frames, ws, i, composite)
+        composite = composite_add_link(links, frames, i, composite)
+        check = support_column(links, frames, ws, D, i, composite, mimic,
+                               check)
+        composite = composite_to_parent(links, frames, ws, i, composite,
+                                        z3, z6)
     if mimic:       # sums of finite entries may still overflow
         return matrix_status(D)
     return -1 if check == zero else OVERFLOW
+
+
+@njit(cache=True, inline='always')
+def composite_start(links, frames, ws, i, composite):
+    """
+    Return composite i before link i: what its children carried back.
+
+    On a chain that is the child's composite, in registers; a branch
+    point adds the sum its later children put into its ``W_ACC``.
+    """
+    if not branch_point(links, frames, i):
+        return composite
+    Mc, h, Io = composite
+    a = W_ACC
+    Mc = Mc + ws[i, a]
+    h = (h[0] + ws[i, a + 1], h[1] + ws[i, a + 2], h[2] + ws[i, a + 3])
+    Io = (Io[0] + ws[i, a + 4], Io[1] + ws[i, a + 5],
+          Io[2] + ws[i, a + 6], Io[3] + ws[i, a + 7],
+          Io[4] + ws[i, a + 8], Io[5] + ws[i, a + 9])
+    return (Mc, h, Io)
+
+
+@njit(cache=True, inline='always')
+def composite_add_link(links, frames, i, composite):
+    """
+    Return composite i with link i added, in frame i about O_i.
+
+    h += m c, I += I_c + m (|c|^2 1 - c c^T), with the symmetric part of
+    I_c (stored as xx, yy, zz, xy, yz, xz).
+    """
+    Mc, h, Io = composite
+    half = frames[F_CONST, C_HALF]
+    m = links[i, L_MASS]
+    c0 = links[i, L_COM]
+    c1 = links[i, L_COM + 1]
+    c2 = links[i, L_COM + 2]
+    mc0 = m * c0
+    mc1 = m * c1
+    mc2 = m * c2
+    k = L_INERTIA
+    Mc = Mc + m
+    h = (h[0] + mc0, h[1] + mc1, h[2] + mc2)
+    Io = (Io[0] + links[i, k] + (mc1 * c1 + mc2 * c2),
+          Io[1] + links[i, k + 4] + (mc0 * c0 + mc2 * c2),
+          Io[2] + links[i, k + 8] + (mc0 * c0 + mc1 * c1),
+          Io[3] + half * (links[i, k + 1] + links[i, k + 3]) - mc0 * c1,
+          Io[4] + half * (links[i, k + 5] + links[i, k + 7]) - mc1 * c2,
+          Io[5] + half * (links[i, k + 2] + links[i, k + 6]) - mc0 * c2)
+    return (Mc, h, Io)
+
+
+@njit(cache=True, inline='always')
+def support_column(links, frames, ws, D, i, composite, mimic, check):
+    """
+    Fill column i of D (and row i) on joint i's support; return ``check``.
+
+    The wrench composite i needs for a unit rate of joint i (F = z x h,
+    N = I z revolute; F = Mc z, N = h x z prismatic) gives D[i, i], then
+    goes up the ancestors j of i by the recursion's backward step
+    (``force_to_parent``), each giving D[j, i] = D[i, j].  ``check``
+    comes back plus zero times each entry (nan or inf if one is not
+    finite).
+    """
+    zero = frames[F_CONST, C_ZERO]
+    Mc, h, Io = composite
+    if revolute(links, frames, i):
+        F = (-h[1], h[0], zero)
+        N = (Io[5], Io[4], Io[2])
+        put_pair(links, D, i, i, N[2], mimic)
+        check = check + zero * N[2]
+    else:
+        F = (zero, zero, Mc)
+        N = (h[1], -h[0], zero)
+        put_pair(links, D, i, i, F[2], mimic)
+        check = check + zero * F[2]
+    k = i
+    j = parent(links, i)
+    while j >= 0:
+        R, p = stored_placement(ws, k)
+        F, N = force_to_parent(R, p, F, N)
+        if revolute(links, frames, j):
+            x = N[2]
+        else:
+            x = F[2]
+        put_pair(links, D, j, i, x, mimic)
+        put_pair(links, D, i, j, x, mimic)
+        check = check + zero * x
+        k = j
+        j = parent(links, j)
+    return check
+
+
+@njit(cache=True, inline='always')
+def composite_to_parent(links, frames, ws, i, composite, z3, z6):
+    """
+    Return what composite i hands on: itself in its parent's frame.
+
+    About the parent's origin: h' = R h + Mc p and
+    I' = R I R^T + 2 (gp . p) 1 - (gp p^T + p gp^T), gp = R h + Mc p / 2.
+    At a branch (the parent is not body i - 1) it goes into the parent's
+    ``W_ACC`` sum instead, and a root hands on nothing: both return the
+    empty composite (``z3``, ``z6``: zero tuples).
+    """
+    Mc, h, Io = composite
+    zero = frames[F_CONST, C_ZERO]
+    par = parent(links, i)
+    if par < 0:
+        return (zero, z3, z6)
+    half = frames[F_CONST, C_HALF]
+    R, p = stored_placement(ws, i)
+    hr = rot(R, h[0], h[1], h[2])
+    Ir = sym_rotate(R, Io)
+    hMc = half * Mc
+    gp = (hr[0] + hMc * p[0], hr[1] + hMc * p[1], hr[2] + hMc * p[2])
+    gp0 = gp[0] * p[0]
+    gp1 = gp[1] * p[1]
+    gp2 = gp[2] * p[2]
+    Io = (Ir[0] + ((gp1 + gp2) + (gp1 + gp2)),
+          Ir[1] + ((gp0 + gp2) + (gp0 + gp2)),
+          Ir[2] + ((gp0 + gp1) + (gp0 + gp1)),
+          Ir[3] - (gp[0] * p[1] + gp[1] * p[0]),
+          Ir[4] - (gp[1] * p[2] + gp[2] * p[1]),
+          Ir[5] - (gp[0] * p[2] + gp[2] * p[0]))
+    h = (hr[0] + Mc * p[0], hr[1] + Mc * p[1], hr[2] + Mc * p[2])
+    if par == i - 1:
+        return (Mc, h, Io)
+    a = W_ACC               # a branch: into the parent's sum
+    ws[par, a] += Mc
+    for k in range(3):
+        ws[par, a + 1 + k] += h[k]
+    for k in range(6):
+        ws[par, a + 4 + k] += Io[k]
+    return (zero, z3, z6)

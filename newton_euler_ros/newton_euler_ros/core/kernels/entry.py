@@ -48,8 +48,9 @@ from .derivatives import aba_derivatives, rnea_derivatives
 from .kinematics import forward_kinematics, jacobian, joint_trig
 from .layout import (F_ROWS, F_TREE, GRAVITY, LINK_WRENCHES, OVERFLOW,
                      SINGULAR, T_NQ, VELOCITY, WRENCH_BITS, WRENCH_SHIFT)
+from .momentum import momentum_terms
 from .newton_euler import (coriolis_matrix_columns, gravity,
-                           mass_matrix_columns, momentum_terms, recursion)
+                           mass_matrix_columns, recursion)
 from .regressor import drive_columns, regressor_columns
 from .status import first_nonfinite, matrix_status
 

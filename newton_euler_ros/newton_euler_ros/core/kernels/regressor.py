@@ -71,110 +71,156 @@ def regressor_columns(links, frames, q, qd, qdd, ws, line, acc, Y):
     axis as a line in frame 0, ``acc`` (10nb, 6) for each column's wrench
     in frame 0 (force, then moment about the origin of frame 0).  Y's
     first 10nb columns are overwritten.
+
+    The steps: per body from the base, :func:`regressor_start` picks the
+    state it starts from, :func:`regressor_step` takes it on (its pose
+    in frame 0, its joint's axis, its kinematics) and
+    :func:`link_columns` writes its ten wrenches; then
+    :func:`joint_rows` gives each joint its share.
     """
-    nb = links.shape[0]
-    n = Y.shape[0]
     zero = frames[F_CONST, C_ZERO]
     one = frames[F_CONST, C_ONE]
-    two = one + one
     mimic = has_mimic(links, frames)
     a_base = (-frames[F_GRAV, 0], -frames[F_GRAV, 1], -frames[F_GRAV, 2])
-    ae = a_base
-    w = (zero, zero, zero)
-    al = (zero, zero, zero)
-    # pose of kernel frame j in frame 0
+    z3 = (zero, zero, zero)
+    # pose of kernel frame j in frame 0, w, al, origin acceleration
     ident = (one, zero, zero, zero, one, zero, zero, zero, one)
-    R0 = ident
-    o0 = (zero, zero, zero)
-    # forward pass, base to tip: kinematics in kernel frame j, the link's
-    # 6 x 10 block in link axes, then its columns in frame 0
+    base = (ident, z3, z3, z3, a_base)
+    state = base
     joint_trig(links, frames, q, ws)
-    for j in range(nb):
-        par = parent(links, j)
-        if par != j - 1:        # a branch: start from the parent's state
-            if par < 0:
-                R0 = ident
-                o0 = (zero, zero, zero)
-                w = (zero, zero, zero)
-                al = (zero, zero, zero)
-                ae = a_base
-            else:
-                R0 = load9(ws, par, W_X)
-                o0 = load3(ws, par, W_X + 9)
-                w = load3(ws, par, W_X + 12)
-                al = load3(ws, par, W_X + 15)
-                ae = load3(ws, par, W_X + 18)
-        R, p = link_geometry(links, frames, j, ws)
-        t = rot(R0, p[0], p[1], p[2])
-        o0 = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
-        R0 = matmul(R0, R)
-        z = (R0[2], R0[5], R0[8])
-        oz = cross(o0[0], o0[1], o0[2], z[0], z[1], z[2])
-        _store(line, j, z, oz)
-        # (al, origin acceleration) carried into frame j, then the joint
-        al, ae = _accel_to_child(R, p, w, al, ae)
-        w = rot_t(R, w[0], w[1], w[2])
-        qdj = joint_rate(links, qd, j, mimic)
-        qddj = joint_rate(links, qdd, j, mimic)
-        if revolute(links, frames, j):
-            al = (al[0] + w[1] * qdj, al[1] - w[0] * qdj, al[2] + qddj)
-            w = (w[0], w[1], w[2] + qdj)
-        else:
-            ae = (ae[0] + two * w[1] * qdj, ae[1] - two * w[0] * qdj,
-                  ae[2] + qddj)
-        if branch_point(links, frames, j):
-            for k in range(9):
-                ws[j, W_X + k] = R0[k]
-            for k in range(3):
-                ws[j, W_X + 9 + k] = o0[k]
-                ws[j, W_X + 12 + k] = w[k]
-                ws[j, W_X + 15 + k] = al[k]
-                ws[j, W_X + 18 + k] = ae[k]
-        # the link frame B in kernel frame j: kinematics in link axes
-        RB = load9(links, j, L_BODY)
-        pB = load3(links, j, L_BODY + 9)
-        ll, a = _accel_to_child(RB, pB, w, al, ae)
-        wl = rot_t(RB, w[0], w[1], w[2])
-        RL = matmul(R0, RB)
-        t = rot(R0, pB[0], pB[1], pB[2])
-        oL = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
-        col = 10 * j
-        # m: force a, no moment about the link origin
-        _put(acc, col, RL, oL, a, (zero, zero, zero))
-        # m c_i: force al x e_i + w x (w x e_i), moment e_i x a
-        _put(acc, col + 1, RL, oL,
-             (zero - wl[1] * wl[1] - wl[2] * wl[2],
-              ll[2] + wl[0] * wl[1], wl[0] * wl[2] - ll[1]),
-             (zero, zero - a[2], a[1]))
-        _put(acc, col + 2, RL, oL,
-             (wl[0] * wl[1] - ll[2],
-              zero - wl[0] * wl[0] - wl[2] * wl[2],
-              ll[0] + wl[1] * wl[2]),
-             (a[2], zero, zero - a[0]))
-        _put(acc, col + 3, RL, oL,
-             (ll[1] + wl[0] * wl[2], wl[1] * wl[2] - ll[0],
-              zero - wl[0] * wl[0] - wl[1] * wl[1]),
-             (zero - a[1], a[0], zero))
-        # inertia entries: moment I al + w x (I w), no force
-        a0, a1, a2 = ll
-        w0, w1, w2 = wl
-        zz = (zero, zero, zero)
-        _put(acc, col + 4, RL, oL, zz,
-             _imom((a0, zero, zero), (w0, zero, zero), wl))      # Ixx
-        _put(acc, col + 5, RL, oL, zz,
-             _imom((a1, a0, zero), (w1, w0, zero), wl))          # Ixy
-        _put(acc, col + 6, RL, oL, zz,
-             _imom((zero, a1, zero), (zero, w1, zero), wl))      # Iyy
-        _put(acc, col + 7, RL, oL, zz,
-             _imom((a2, zero, a0), (w2, zero, w0), wl))          # Ixz
-        _put(acc, col + 8, RL, oL, zz,
-             _imom((zero, a2, a1), (zero, w2, w1), wl))          # Iyz
-        _put(acc, col + 9, RL, oL, zz,
-             _imom((zero, zero, a2), (zero, zero, w2), wl))      # Izz
-    # each joint takes the moment about (revolute) or the force along
-    # (prismatic) its axis of the wrenches of the links it carries: link
-    # k's ten columns go to k and its ancestors, every other entry is zero
-    for r in range(n):
+    for j in range(links.shape[0]):
+        state = regressor_start(links, ws, j, state, base)
+        state = regressor_step(links, frames, qd, qdd, ws, line, j, mimic,
+                               state)
+        link_columns(links, frames, j, state, acc)
+    joint_rows(links, frames, line, acc, Y, mimic)
+
+
+@njit(cache=True, inline='always')
+def regressor_start(links, ws, j, state, base):
+    """
+    Return body j's starting ``(R0, o0, w, al, ae)``: its parent's.
+
+    A branch point's is stored (``W_X``); a root starts from ``base``.
+    """
+    par = parent(links, j)
+    if par == j - 1:
+        return state
+    if par < 0:
+        return base
+    return (load9(ws, par, W_X), load3(ws, par, W_X + 9),
+            load3(ws, par, W_X + 12), load3(ws, par, W_X + 15),
+            load3(ws, par, W_X + 18))
+
+
+@njit(cache=True, inline='always')
+def regressor_step(links, frames, qd, qdd, ws, line, j, mimic, state):
+    """
+    Take the state from body j's parent to body j; return body j's.
+
+    Kernel frame j's pose in frame 0 (R0, o0), joint j's axis as a line
+    in frame 0 (``line[j]``: z, o0 x z), then w, al and the acceleration
+    of O_j in frame j axes; a branch point stores its state (``W_X``).
+    """
+    R0, o0, w, al, ae = state
+    one = frames[F_CONST, C_ONE]
+    two = one + one
+    R, p = link_geometry(links, frames, j, ws)
+    t = rot(R0, p[0], p[1], p[2])
+    o0 = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
+    R0 = matmul(R0, R)
+    z = (R0[2], R0[5], R0[8])
+    oz = cross(o0[0], o0[1], o0[2], z[0], z[1], z[2])
+    _store(line, j, z, oz)
+    # (al, origin acceleration) carried into frame j, then the joint
+    al, ae = _accel_to_child(R, p, w, al, ae)
+    w = rot_t(R, w[0], w[1], w[2])
+    qdj = joint_rate(links, qd, j, mimic)
+    qddj = joint_rate(links, qdd, j, mimic)
+    if revolute(links, frames, j):
+        al = (al[0] + w[1] * qdj, al[1] - w[0] * qdj, al[2] + qddj)
+        w = (w[0], w[1], w[2] + qdj)
+    else:
+        ae = (ae[0] + two * w[1] * qdj, ae[1] - two * w[0] * qdj,
+              ae[2] + qddj)
+    if branch_point(links, frames, j):
+        for k in range(9):
+            ws[j, W_X + k] = R0[k]
+        for k in range(3):
+            ws[j, W_X + 9 + k] = o0[k]
+            ws[j, W_X + 12 + k] = w[k]
+            ws[j, W_X + 15 + k] = al[k]
+            ws[j, W_X + 18 + k] = ae[k]
+    return (R0, o0, w, al, ae)
+
+
+@njit(cache=True, inline='always')
+def link_columns(links, frames, j, state, acc):
+    """
+    Write link j's ten columns, the wrenches of its 6 x 10 block, in frame 0.
+
+    In the link frame B (``L_BODY``: B in kernel frame j), the wrench
+    each inertial parameter (m, m c, the six entries of I about B's
+    origin) causes, carried to frame 0 into ``acc[10 j:10 j + 10]``.
+    """
+    R0, o0, w, al, ae = state
+    zero = frames[F_CONST, C_ZERO]
+    RB = load9(links, j, L_BODY)
+    pB = load3(links, j, L_BODY + 9)
+    ll, a = _accel_to_child(RB, pB, w, al, ae)
+    wl = rot_t(RB, w[0], w[1], w[2])
+    RL = matmul(R0, RB)
+    t = rot(R0, pB[0], pB[1], pB[2])
+    oL = (o0[0] + t[0], o0[1] + t[1], o0[2] + t[2])
+    col = 10 * j
+    # m: force a, no moment about the link origin
+    _put(acc, col, RL, oL, a, (zero, zero, zero))
+    # m c_i: force al x e_i + w x (w x e_i), moment e_i x a
+    _put(acc, col + 1, RL, oL,
+         (zero - wl[1] * wl[1] - wl[2] * wl[2],
+          ll[2] + wl[0] * wl[1], wl[0] * wl[2] - ll[1]),
+         (zero, zero - a[2], a[1]))
+    _put(acc, col + 2, RL, oL,
+         (wl[0] * wl[1] - ll[2],
+          zero - wl[0] * wl[0] - wl[2] * wl[2],
+          ll[0] + wl[1] * wl[2]),
+         (a[2], zero, zero - a[0]))
+    _put(acc, col + 3, RL, oL,
+         (ll[1] + wl[0] * wl[2], wl[1] * wl[2] - ll[0],
+          zero - wl[0] * wl[0] - wl[1] * wl[1]),
+         (zero - a[1], a[0], zero))
+    # inertia entries: moment I al + w x (I w), no force
+    a0, a1, a2 = ll
+    w0, w1, w2 = wl
+    zz = (zero, zero, zero)
+    _put(acc, col + 4, RL, oL, zz,
+         _imom((a0, zero, zero), (w0, zero, zero), wl))      # Ixx
+    _put(acc, col + 5, RL, oL, zz,
+         _imom((a1, a0, zero), (w1, w0, zero), wl))          # Ixy
+    _put(acc, col + 6, RL, oL, zz,
+         _imom((zero, a1, zero), (zero, w1, zero), wl))      # Iyy
+    _put(acc, col + 7, RL, oL, zz,
+         _imom((a2, zero, a0), (w2, zero, w0), wl))          # Ixz
+    _put(acc, col + 8, RL, oL, zz,
+         _imom((zero, a2, a1), (zero, w2, w1), wl))          # Iyz
+    _put(acc, col + 9, RL, oL, zz,
+         _imom((zero, zero, a2), (zero, zero, w2), wl))      # Izz
+
+
+@njit(cache=True, inline='always')
+def joint_rows(links, frames, line, acc, Y, mimic):
+    """
+    Give each joint the wrenches of the links it carries: Y's 10nb columns.
+
+    Joint j takes the moment about (revolute) or the force along
+    (prismatic) its axis (``line[j]``): link k's ten columns go to k and
+    its ancestors, every other entry is zero; a mimic joint's share goes
+    to its lead's row times its multiplier.
+    """
+    zero = frames[F_CONST, C_ZERO]
+    one = frames[F_CONST, C_ONE]
+    nb = links.shape[0]
+    for r in range(Y.shape[0]):
         for col in range(10 * nb):
             Y[r, col] = zero
     for k in range(nb):
