@@ -22,6 +22,7 @@
     newton-euler check ROBOT
     newton-euler urdf ROBOT [-o FILE]
     newton-euler feedforward ROBOT TRAJECTORY.json [--wrench ...] [--gains Q R]
+                             [--drives]
     newton-euler robots
     newton-euler excite | identify | replay | payload | observe ...
     newton-euler send TRAJECTORY.json | record BAG   (on a live ROS graph)
@@ -340,6 +341,14 @@ def cmd_feedforward(args):
     wrench = (np.array(_numbers(args.wrench, '--wrench'))
               if args.wrench is not None else None)
     wrench, frame = _at_link(model, wrench, args.wrench_frame, args.link)
+    drives = None
+    if args.drives:
+        drives = model_drives(model)
+        if drives is None:
+            raise InputError(
+                f'--drives: {args.robot} has no drive terms (they come '
+                f'from a URDF\'s <dynamics damping/friction> and '
+                f'<ne:drive>, as identify writes them)')
     hold, left = None, []
     if (model.info.get('urdf') or {}).get('tree'):
         # a whole robot: the joints the trajectory leaves out stay at zero
@@ -349,14 +358,14 @@ def cmd_feedforward(args):
                 if isinstance(names, list) and j not in names]
     # an error is the one line: the note only once the efforts are filled
     filled = fill_efforts(model, trajectory, wrench, frame,
-                          where=f'{path}: ', hold=hold)
+                          where=f'{path}: ', hold=hold, drives=drives)
     if left:
         print(f'note: joints not in the trajectory held at 0, at rest: '
               f'{", ".join(left)}', file=sys.stderr)
     if args.gains is not None:
         from .cli_gains import add_gains
         add_gains(model, filled, args.gains, wrench, frame, f'{path}: ',
-                  hold)
+                  hold, drives)
     print(json.dumps(filled))
     return 0
 
@@ -473,6 +482,11 @@ def build_parser():
                          ' ("gains", n x 2n): Q is P,V (position and '
                          'velocity weights) or 2n values, R one torque '
                          'weight or n values, comma-separated')
+    ff.add_argument('--drives', action='store_true',
+                    help="add the model's drive terms (viscous and Coulomb "
+                         'friction, offset, rotor inertia) to the efforts, '
+                         "as the node's drives.compensate does; with "
+                         '--gains they join the linearised dynamics')
     ff.set_defaults(func=cmd_feedforward)
     rob = sub.add_parser('robots', help='list the bundled robots')
     rob.set_defaults(func=cmd_robots)

@@ -60,8 +60,14 @@ def weights(state_text, input_text, k):
     return state, torque
 
 
-def add_gains(model, filled, gains, wrench, wrench_frame, where, hold):
-    """Write ``"gains"`` into every point of ``filled`` (in place)."""
+def add_gains(model, filled, gains, wrench, wrench_frame, where, hold,
+              drives=None):
+    """
+    Write ``"gains"`` into every point of ``filled`` (in place).
+
+    ``drives`` (a ``core.drives.Drives`` or None) join the linearised
+    dynamics as they joined the efforts.
+    """
     names = filled['joint_names']
     if hold is not None and len(names) != model.n:
         raise GainsOptionError(
@@ -82,7 +88,7 @@ def add_gains(model, filled, gains, wrench, wrench_frame, where, hold):
     try:
         result = trajectory_gains(model, times, Q, QD, QDD, state_model,
                                   torque_model, wrench=wrench,
-                                  wrench_frame=wrench_frame)
+                                  wrench_frame=wrench_frame, drives=drives)
     except LqrError as exc:
         text = str(exc).replace('state weights', '--gains Q')
         raise GainsOptionError(text.replace('input weights', '--gains R')) \

@@ -283,12 +283,12 @@ def trajectory_efforts(model, joint_names, points, wrench=None,
 
 
 def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
-                 where='', hold=None):
+                 where='', hold=None, drives=None):
     """
     Return a JSON-style trajectory dict with ``effort`` in every point.
 
-    ``wrench``, ``wrench_frame`` and ``hold`` as :func:`trajectory_efforts`
-    takes them.
+    ``wrench``, ``wrench_frame``, ``hold`` and ``drives`` as
+    :func:`trajectory_efforts` takes them.
     """
     names = trajectory.get('joint_names')
     if not isinstance(names, list) or not all(isinstance(x, str)
@@ -305,7 +305,7 @@ def fill_efforts(model, trajectory, wrench=None, wrench_frame='base',
             raise TrajectoryError(f'{where}points[{k}]: unknown key '
                                   f'{sorted(unknown)[0]!r}')
     efforts = trajectory_efforts(model, names, points, wrench, wrench_frame,
-                                 where, hold=hold)
+                                 where, hold=hold, drives=drives)
     out = dict(trajectory)
     out['points'] = [dict(p, effort=e.tolist())
                      for p, e in zip(points, efforts)]

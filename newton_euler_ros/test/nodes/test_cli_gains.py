@@ -87,3 +87,72 @@ def test_bad_weights_exit_2_in_one_line():
                              *gains)
         assert code == 2 and out == '', err
         assert message in err and err.count('\n') == 1, err
+
+
+# per joint of the Puma: damping, friction, armature, offset, coulomb width
+DRIVES = [(0.5, 1.2, 0.3, -0.1, 0.02), (0.7, 2.0, 0.4, 0.2, 0.05),
+          (0.4, 0.9, 0.2, 0.0, 0.02), (0.1, 0.3, 0.05, 0.05, 0.02),
+          (0.1, 0.2, 0.04, -0.02, 0.1), (0.05, 0.1, 0.02, 0.01, 0.02)]
+NS = 'https://newton-euler-ros.github.io/ns/drives/1'
+
+
+def puma_with_drives(tmp_path):
+    """The Puma as a URDF whose joints carry the drive terms of DRIVES."""
+    path = tmp_path / 'puma.urdf'
+    code, _, err = run('urdf', 'puma560', '-o', str(path))
+    assert code == 0, err
+    text = path.read_text().replace('<robot ', f'<robot xmlns:ne="{NS}" ', 1)
+    parts = text.split('</joint>')
+    k = 0
+    for i, part in enumerate(parts[:-1]):
+        if 'type="fixed"' in part.rsplit('<joint ', 1)[-1]:
+            continue
+        b, f, a, o, w = DRIVES[k]
+        parts[i] = (part + f'<dynamics damping="{b}" friction="{f}"/>'
+                    f'<ne:drive armature="{a}" offset="{o}" '
+                    f'coulomb_width="{w}"/>')
+        k += 1
+    assert k == 6
+    path.write_text('</joint>'.join(parts))
+    return str(path)
+
+
+def test_drives_add_their_torques_and_join_the_gains(tmp_path):
+    urdf = puma_with_drives(tmp_path)
+    code, plain, err = run('feedforward', urdf, MOVE, '--tip', 'tool0')
+    assert code == 0, err
+    code, out, err = run('feedforward', urdf, MOVE, '--tip', 'tool0',
+                         '--drives', '--gains', '100,10', '0.01')
+    assert code == 0, err
+    with open(MOVE, encoding='utf-8') as fh:
+        traj = json.load(fh)
+    with warnings.catch_warnings():
+        warnings.simplefilter('ignore')
+        from newton_euler_ros.core import load_urdf
+        model = load_urdf(urdf, tip='tool0')
+    times, Q, QD, QDD = trajectory_arrays(model, traj['joint_names'],
+                                          traj['points'])
+    b, f, a, o, w = np.array(DRIVES).T
+    # each drive torque by hand: b qd + f tanh(qd / w) + offset + a qdd
+    by_hand = b * QD + f * np.tanh(QD / w) + o + a * QDD
+    filled = json.loads(out)
+    for k, (point, bare) in enumerate(zip(filled['points'],
+                                          json.loads(plain)['points'])):
+        np.testing.assert_allclose(
+            np.subtract(point['effort'], bare['effort']), by_hand[k],
+            rtol=1e-12, atol=1e-12)
+    gains = trajectory_gains(model, times, Q, QD, QDD, [100] * 6 + [10] * 6,
+                             0.01, drives=model.info['drives'])
+    bare = trajectory_gains(model, times, Q, QD, QDD, [100] * 6 + [10] * 6,
+                            0.01)
+    K = np.array([p['gains'] for p in filled['points']])
+    np.testing.assert_allclose(K, gains.K, rtol=1e-12, atol=1e-12)
+    # the drives change the gains: damping and rotor inertia slow the arm
+    assert np.abs(K - bare.K).max() > 1e-3 * np.abs(bare.K).max()
+
+
+def test_drives_on_a_robot_without_them_exit_2_in_one_line():
+    code, out, err = run('feedforward', 'puma560', MOVE, '--drives')
+    assert code == 2 and out == '', err
+    assert '--drives: puma560 has no drive terms' in err, err
+    assert err.count('\n') == 1, err
