@@ -347,7 +347,7 @@ def cmd_feedforward(args):
         if drives is None:
             raise InputError(
                 f'--drives: {args.robot} has no drive terms (they come '
-                f'from a URDF\'s <dynamics damping/friction> and '
+                f"from a URDF's <dynamics damping/friction> and "
                 f'<ne:drive>, as identify writes them)')
     hold, left = None, []
     if (model.info.get('urdf') or {}).get('tree'):

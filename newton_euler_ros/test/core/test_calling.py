@@ -57,4 +57,3 @@ def test_one_signature_and_every_other_type_refused():
     with pytest.raises(calling.Refused):
         entry(arm.packed, q, ws.ws, np.empty(arm.n, np.float32))
     assert len(entry.signatures) == 1, 'a miss compiled a new signature'
-

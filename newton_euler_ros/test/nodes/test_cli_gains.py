@@ -97,7 +97,7 @@ NS = 'https://newton-euler-ros.github.io/ns/drives/1'
 
 
 def puma_with_drives(tmp_path):
-    """The Puma as a URDF whose joints carry the drive terms of DRIVES."""
+    """Write the Puma as a URDF whose joints carry DRIVES; return its path."""
     path = tmp_path / 'puma.urdf'
     code, _, err = run('urdf', 'puma560', '-o', str(path))
     assert code == 0, err

@@ -13,8 +13,7 @@
 # limitations under the License.
 
 """
-D qd, C(q, qd)^T qd and g(q) in one recursion: the momentum observer's
-terms.
+The momentum observer's terms: D qd, C(q, qd)^T qd and g(q) at once.
 
 :func:`momentum_terms` carries each link's velocity out from the base,
 then the composite momentum and gravity wrench in from the tip, and
