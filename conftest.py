@@ -25,6 +25,7 @@ workspace without the peers) may still skip.  The one skip allowed is
 """
 import os
 import signal
+import time
 
 import pytest
 
@@ -120,3 +121,27 @@ def pytest_collection_modifyitems(session, config, items):
     rank = {p: k for k, p in enumerate(LONGEST_FIRST)}
     items.sort(key=lambda item: rank.get(
         os.path.relpath(str(item.path), root), len(rank)))
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    """
+    Append each test's wall and CPU seconds to build/test_seconds.txt.
+
+    CPU is the worker's own and its finished children's (``os.times``),
+    set-up and teardown included, so a node a fixture started is counted
+    where it is stopped.  A record for finding where the suite's time
+    goes (``docs/tests.md``), not a check: a write that fails is ignored.
+    """
+    wall, before = time.monotonic(), os.times()
+    yield
+    after = os.times()
+    cpu = sum(after[k] - before[k] for k in range(4))
+    path = os.path.join(str(item.config.rootpath), 'build',
+                        'test_seconds.txt')
+    try:
+        with open(path, 'a', encoding='utf-8') as fh:
+            fh.write(f'{time.monotonic() - wall:8.2f} {cpu:8.2f}  '
+                     f'{item.nodeid}\n')
+    except OSError:
+        pass
