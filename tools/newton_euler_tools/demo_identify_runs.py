@@ -40,6 +40,7 @@ from .ident_example import BASE, TIP
 
 JOINTS = [f'panda_joint{k}' for k in range(1, 8)]
 CONTROLLER = '/trajectory_controller'
+PLAN_RESEND = 2.0     # s without the controller's start: send the plan again
 # per plant: the topic the node's filled plan goes to, the topic of t = 0
 # of the plan, the plant's command topic
 TOPICS = {
@@ -201,6 +202,7 @@ class LoopRun:
         self.status = {}
         self.segment = None
         self.sent = False
+        self.resent = 0             # plans sent again (MuJoCo: see begun)
         self._stopper = None
         self.closed = False
         self.times = {'start': time.monotonic()}    # wall clock, per phase
@@ -306,12 +308,23 @@ class LoopRun:
         self.check()
         rec = self.rec
         if self.plant == 'mujoco':
-            # stamped 0: the controller starts it at the next state
-            if not self.sent and rec.states:
+            # stamped 0: the controller starts it at the next state and
+            # says so on its latched ~/start.  No start PLAN_RESEND s
+            # after sending: the plan was lost on its way (the node's
+            # publisher may match the controller after the recorder saw
+            # both; a message before that is gone), so it is sent again.
+            now = time.monotonic()
+            if rec.t0 is None and rec.states and (
+                    not self.sent
+                    or now - self.times['plan sent'] > PLAN_RESEND):
+                if self.sent:
+                    self.resent += 1
+                    print(f'[{self.label}] no start {PLAN_RESEND:g} s after '
+                          'the plan was sent: sending it again', flush=True)
                 rec.plan.publish(trajectory_message(JOINTS, 0.0,
                                                     self.segment))
                 self.sent = True
-                self.times['plan sent'] = time.monotonic()
+                self.times['plan sent'] = now
             return self.sent and rec.t0 is not None
         if not self.sent and rec.t0 is not None:
             rec.plan.publish(trajectory_message(JOINTS, rec.t0,

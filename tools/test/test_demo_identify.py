@@ -112,3 +112,45 @@ def test_quick_identification_loop_on_the_builtin_plant(tmp_path):
     # torque (about a tenth of the published URDF's error)
     assert identified['ff_rms'] < 0.5 * published['ff_rms']
     check_payload(out, result, identified, 4)
+
+
+class _Plan:
+    def __init__(self):
+        self.sent = []
+
+    def publish(self, msg):
+        self.sent.append(msg)
+
+
+class _Recorder:
+    """What LoopRun.begun reads of its recorder: states, t0, the plan."""
+
+    def __init__(self):
+        self.states, self.t0, self.plan = [(0.0,)], None, _Plan()
+
+
+def test_a_lost_plan_is_sent_again_until_the_controller_starts(monkeypatch):
+    """
+    On MuJoCo a plan lost on its way (no ~/start) is sent again.
+
+    A run once waited 120 s for a start that could not come: the node's
+    publisher had not yet matched the controller when the plan went out.
+    A started plan is never sent twice (its start is latched).
+    """
+    from newton_euler_tools import demo_identify_runs as runs
+    clock = [100.0]
+    monkeypatch.setattr(runs.time, 'monotonic', lambda: clock[0])
+    run = runs.LoopRun.__new__(runs.LoopRun)
+    run.label, run.plant, run.sent, run.resent = 'lost', 'mujoco', False, 0
+    run.children, run._stopper, run.times = [], None, {}
+    run.segment = (np.array([0.0, 1.0]), np.zeros((2, 7)), np.zeros((2, 7)),
+                   np.zeros((2, 7)))
+    run.rec = rec = _Recorder()
+    assert not run.begun() and len(rec.plan.sent) == 1
+    clock[0] += runs.PLAN_RESEND / 2
+    assert not run.begun() and len(rec.plan.sent) == 1     # not yet
+    clock[0] += runs.PLAN_RESEND
+    assert not run.begun() and len(rec.plan.sent) == 2 and run.resent == 1
+    rec.t0 = 0.0                                            # it started
+    clock[0] += 10 * runs.PLAN_RESEND
+    assert run.begun() and len(rec.plan.sent) == 2
