@@ -21,6 +21,9 @@
 # Env:   PYTHON=/path/to/python3.11      interpreter for the venv
 #        WHEELHOUSE=DIR|off              where pinned wheels are kept for fast
 #                                        re-creation (default ~/.cache/newton_euler_ros/wheelhouse)
+#        IFACE_CACHE=DIR|off             where built newton_euler_interfaces
+#                                        installs are kept, by input hash
+#                                        (default ~/.cache/newton_euler_ros/interfaces)
 #        SETUP_FORCE=1                   ignore the stamps, redo every step
 set -euo pipefail
 
@@ -37,6 +40,7 @@ PKG_SRC="$ROOT/newton_euler_ros"
 TOOLS_SRC="$ROOT/tools"
 PY_MINOR="3.11"
 PY_TUPLE="3, 11"   # same version, as a Python tuple
+IFACE_CACHE_ROOT="${IFACE_CACHE:-${XDG_CACHE_HOME:-${HOME:-$ROOT/build}/.cache}/newton_euler_ros/interfaces}"
 WHEELHOUSE_ROOT="${WHEELHOUSE:-${XDG_CACHE_HOME:-${HOME:-$ROOT/build}/.cache}/newton_euler_ros/wheelhouse}"
 
 log() { printf '[setup %3ds] %s\n' "$SECONDS" "$*"; }
@@ -265,13 +269,9 @@ unset COLCON_PREFIX_PATH
 
 # ---------------------------------------------------------------------------
 # Step 2: newton_euler_interfaces -> .venv (lib/, share/, site-packages/).
-if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok interfaces "$H_IFACE"; then
-  log "step 2/4: build + install newton_euler_interfaces into .venv"
-  rm -f "$STAMPS/interfaces"   # a failed attempt may leave a half install
-  command -v cmake >/dev/null || die "cmake not found (apt-get install cmake)"
-  command -v c++ >/dev/null || die "no C++ compiler (apt-get install g++)"
-  # Fresh build dir each time: it takes seconds, and no stale generated code
-  # from a renamed/removed .srv can survive.
+iface_build() {
+  # Fresh build dir each time: no stale generated code from a
+  # renamed/removed .srv can survive.
   rm -rf "$IFACE_BUILD"
   run_logged "$BUILD/interfaces-configure.log" cmake -S "$IFACE_SRC" -B "$IFACE_BUILD" \
     -DCMAKE_INSTALL_PREFIX="$VENV" \
@@ -280,6 +280,59 @@ if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok interfaces "$H_IFACE"; then
     -DPython3_EXECUTABLE="$VENV/bin/python"
   run_logged "$BUILD/interfaces-build.log" cmake --build "$IFACE_BUILD" -j "$(nproc)"
   run_logged "$BUILD/interfaces-install.log" cmake --install "$IFACE_BUILD"
+}
+# The install (27 s of CMake on 2 cores) is kept as a tar of the installed
+# files, relative to the prefix, with the prefix they name.  Only text
+# files may name it (checked when kept): a clone elsewhere rewrites them.
+iface_to_cache() {
+  local manifest="$IFACE_BUILD/install_manifest.txt" rel tmp f
+  [[ -f "$manifest" ]] || return 0
+  rel="$(sed "s|^$VENV/||" "$manifest")"
+  while IFS= read -r f; do
+    if grep -qF "$VENV" "$VENV/$f" && ! grep -qIF "$VENV" "$VENV/$f"; then
+      log "not caching newton_euler_interfaces: $f names $VENV"; return 0
+    fi
+  done <<<"$rel"
+  mkdir -p "$IFACE_CACHE_ROOT" || return 0
+  printf '%s\n' "$VENV" >"$BUILD/interfaces-prefix.txt"
+  tmp="$(mktemp "$IFACE_CACHE_ROOT/.tmp.XXXXXX")" || return 0
+  if tar -cf "$tmp" -C "$BUILD" interfaces-prefix.txt \
+      -C "$VENV" $rel 2>/dev/null; then
+    mv -f "$tmp" "$IFACE_TAR"
+    # keep the four newest
+    ls -1t "$IFACE_CACHE_ROOT"/*.tar 2>/dev/null | tail -n +5 | xargs -r rm -f
+  else
+    rm -f "$tmp"
+  fi
+}
+iface_from_cache() {
+  local old f
+  mkdir -p "$BUILD"
+  tar -xf "$IFACE_TAR" -C "$BUILD" interfaces-prefix.txt 2>/dev/null || return 1
+  old="$(cat "$BUILD/interfaces-prefix.txt")"
+  [[ -n "$old" ]] || return 1
+  tar -xf "$IFACE_TAR" -C "$VENV" --exclude interfaces-prefix.txt || return 1
+  rm -f "$VENV/interfaces-prefix.txt"
+  if [[ "$old" != "$VENV" ]]; then
+    tar -tf "$IFACE_TAR" | grep -v '^interfaces-prefix.txt$' | while IFS= read -r f; do
+      if [[ -f "$VENV/$f" ]] && grep -qIF "$old" "$VENV/$f"; then
+        sed -i "s|$old|$VENV|g" "$VENV/$f"
+      fi
+    done
+  fi
+}
+if [[ "${SETUP_FORCE:-0}" == 1 ]] || ! stamp_ok interfaces "$H_IFACE"; then
+  log "step 2/4: build + install newton_euler_interfaces into .venv"
+  rm -f "$STAMPS/interfaces"   # a failed attempt may leave a half install
+  command -v cmake >/dev/null || die "cmake not found (apt-get install cmake)"
+  command -v c++ >/dev/null || die "no C++ compiler (apt-get install g++)"
+  IFACE_TAR="$IFACE_CACHE_ROOT/$H_IFACE.tar"
+  if [[ "${IFACE_CACHE:-}" != off && -f "$IFACE_TAR" ]] && iface_from_cache; then
+    log "newton_euler_interfaces from the cache: ${IFACE_TAR#"${HOME:-/nonexistent}"/}"
+  else
+    iface_build
+    [[ "${IFACE_CACHE:-}" == off ]] || iface_to_cache
+  fi
   # Import the service AND load its C type support (the .so files in
   # .venv/lib, found through the LD_LIBRARY_PATH the wheel bootstrap sets).
   "$VENV/bin/python" -c '
@@ -288,7 +341,7 @@ from rclpy.type_support import check_for_type_support
 for srv in (ComputeDynamics, Linearize):
     check_for_type_support(srv)
     srv.Request(); srv.Response()
-' || die "newton_euler_interfaces was installed but does not import/load"
+' || { rm -f "$IFACE_TAR"; die "newton_euler_interfaces was installed but does not import/load"; }
   stamp_write interfaces "$H_IFACE"
 fi
 
