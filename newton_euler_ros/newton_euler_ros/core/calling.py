@@ -17,23 +17,27 @@ How Python calls the kernels: strict entries, conversion, status decoding.
 
 The one entry path of every dynamics function is
 
-1. the fast call: the arguments as given, straight into a *strict entry*
-   (:func:`strict_entry`), a numba dispatcher compiled for exactly
-   float64, C-contiguous, writeable arrays.  numba's dispatcher matches
-   argument types in C on every call anyway; for anything else (a list,
-   an int or float32 array, a read-only or strided array) it finds no
-   match and, instead of numba's slow search for a conversion (about
-   100 us), raises :class:`Refused` at once (about 1 us);
+1. the fast call: arrays as given, straight into a *strict entry*
+   (:class:`StrictEntry`), a numba dispatcher compiled for exactly
+   float64, C-contiguous, writeable arrays and allowed no other
+   signature.  numba matches argument types in C on every call anyway;
+   a main input that is not a float64 ndarray (a list, a float32 array)
+   skips this step on one check of its type and dtype in Python, and
+   anything else numba does not match (a read-only or strided array, a
+   workspace of another dtype) raises numba's ``TypeError``, after
+   numba's own search for a conversion: about 0.1 ms;
 2. only then, or when the kernel returns a status code: the arguments
    converted once (:func:`vector`, :func:`out_array`,
    :func:`workspace`), the kernel called again, and its status decoded
    here (:func:`status_error`) into the one-line errors users see.
 
-So a float64 array costs no Python check at all, and a list costs one
-conversion more.
+So a float64 array costs no Python check beyond its type, and a list
+costs one conversion more.  Only numba's public API is used: ``njit``,
+``Dispatcher.compile`` and ``disable_compile``.
 """
 import gc
 import math
+import threading
 
 from numba import njit, types
 import numpy as np
@@ -49,7 +53,7 @@ from .workspace import Workspace
 # and a long-running node's full collections stay short.  Whatever else
 # the process held at this moment is frozen with them; gc.unfreeze()
 # undoes it.  The first kernel load (numba's typing registries) is frozen
-# the same way (``first_call`` below).
+# the same way (``StrictEntry.load`` below).
 gc.freeze()
 
 INPUTS = ('q', 'qd', 'qdd', 'wrench')
@@ -69,43 +73,63 @@ INT = types.int64
 BOOL = types.boolean
 
 
-_F64 = np.dtype(np.float64)     # compared by identity first: cheaper
+_F64 = F64 = np.dtype(np.float64)   # compared by identity first: cheaper
 
 
-class Refused(Exception):
-    """A strict entry was given an argument of another type: convert it."""
-
-
-def _refuse(*args, **kws):
-    raise Refused
-
-
-def strict_entry(kernel, *argtypes):
+class StrictEntry:
     """
-    Return ``kernel`` compiled for exactly ``argtypes``, on first call.
+    A kernel entry point compiled for exactly one signature, on first use.
 
-    The dispatcher takes the entry points' options (``kernels.ENTRY``:
-    numba's cache does not tell compilations of one function with other
-    options apart) and compiles the one signature on its first call (or
-    loads it from the cache), then no other: numba then asks its
-    ``_search_new_conversions`` callback about arguments of any other
-    type, which raises :class:`Refused`.
+    Calling it compiles the one signature ``argtypes`` (or loads it from
+    numba's cache), whatever the arguments, closes the dispatcher to
+    other signatures (``disable_compile``), so that an argument of
+    another type raises numba's ``TypeError`` instead of compiling a
+    variant, and calls it.  With ``home`` (the registering module's
+    ``globals()``), the names there bound to this entry are rebound to
+    the dispatcher itself: from then on a call goes straight into numba's
+    C dispatcher, with no Python frame between.  The dispatcher takes the
+    entry points' options (``kernels.ENTRY``: numba's cache does not tell
+    compilations of one function with other options apart).  Loading
+    only what is called keeps a command's start short: a node on a chain
+    never loads the tree's or the observer's entries.
     """
-    dispatcher = njit(**K.ENTRY)(kernel.py_func)
-    signature = types.int64(*argtypes)
 
-    def first_call(*args, **kws):
-        # numba calls what this returns with the arguments: the
-        # dispatcher itself, now holding the one signature and no other
-        dispatcher.compile(signature)
-        dispatcher.disable_compile()
-        gc.freeze()
-        return dispatcher
+    __slots__ = ('kernel', 'signature', 'dispatcher', 'home', '_lock')
 
-    # numba's callbacks on a type miss: while it may compile, and after
-    dispatcher._compile_for_args = first_call
-    dispatcher._search_new_conversions = _refuse
-    return dispatcher
+    def __init__(self, kernel, *argtypes, home=None):
+        self.kernel = kernel
+        self.signature = types.int64(*argtypes)
+        self.dispatcher = None
+        self.home = home
+        self._lock = threading.Lock()
+
+    def __call__(self, *args):
+        return self.load()(*args)
+
+    def load(self):
+        """Compile (or load from the cache) the one signature; return it."""
+        with self._lock:
+            if self.dispatcher is None:
+                dispatcher = njit(**K.ENTRY)(self.kernel.py_func)
+                dispatcher.compile(self.signature)
+                dispatcher.disable_compile()
+                # numba's typing registries, filled by this first load,
+                # live as long as the process: out of the collector's
+                # sight, as above
+                gc.freeze()
+                self.dispatcher = dispatcher
+            if self.home is not None:
+                for name, value in list(self.home.items()):
+                    if value is self:
+                        self.home[name] = self.dispatcher
+        return self.dispatcher
+
+    def __repr__(self):
+        state = 'loaded' if self.dispatcher is not None else 'not loaded'
+        return f'<StrictEntry {self.kernel.py_func.__name__} ({state})>'
+
+
+strict_entry = StrictEntry
 
 
 # ---------------------------------------------------------------------------

@@ -49,10 +49,9 @@ import numpy as np
 
 from . import kernels as K
 from .batch import run_split
-from .calling import (FD_INPUTS, foreign_workspace, INPUTS, inputs,
-                      INT, MAT, matrix, out_array, PACKED, Refused,
-                      status_error, strict_entry, VEC, vector, workspace,
-                      wrench_mode)
+from .calling import (F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
+                      INT, MAT, matrix, out_array, PACKED, status_error,
+                      strict_entry, VEC, vector, workspace, wrench_mode)
 from .frames import derivative_wrench_rows
 
 __all__ = ['forward_dynamics_derivatives',
@@ -62,16 +61,16 @@ __all__ = ['forward_dynamics_derivatives',
 
 ARRAY3 = types.Array(types.float64, 3, 'C')
 _dtau = strict_entry(K.run_inverse_dynamics_derivatives, PACKED, VEC, VEC,
-                     VEC, VEC, VEC, INT, MAT, MAT, MAT, ARRAY3)
+                     VEC, VEC, VEC, INT, MAT, MAT, MAT, ARRAY3, home=globals())
 _dtau_links = strict_entry(K.run_inverse_dynamics_derivatives_links, PACKED,
                            VEC, VEC, VEC, VEC, MAT, MAT, VEC, INT, MAT, MAT,
-                           MAT, ARRAY3)
+                           MAT, ARRAY3, home=globals())
 _dqdd = strict_entry(K.run_forward_dynamics_derivatives, PACKED, VEC, VEC,
                      VEC, VEC, VEC, VEC, INT, MAT, MAT, MAT, MAT, MAT,
-                     ARRAY3)
+                     ARRAY3, home=globals())
 _dqdd_links = strict_entry(K.run_forward_dynamics_derivatives_links, PACKED,
                            VEC, VEC, VEC, VEC, MAT, MAT, MAT, VEC, VEC, INT,
-                           MAT, MAT, MAT, MAT, MAT, ARRAY3)
+                           MAT, MAT, MAT, MAT, MAT, ARRAY3, home=globals())
 
 
 def drive_slopes(drives, qd, out=None):
@@ -118,23 +117,23 @@ def inverse_dynamics_derivatives(model, q, qd=None, qdd=None, wrench=None,
     """
     w = model.default_workspace if ws is None else ws
     flags = _flags(gravity, wrench, wrench_frame)
-    try:
-        n = w.n
-        res = np.empty((2, n, n)) if out is None else out
-        if type(wrench) is dict:
-            raise Refused
-        damping = w.zeros if drives is None else drive_slopes(
-            drives, w.zeros if qd is None else qd, w.scratch[2])
-        if _dtau(model.packed, q, w.zeros if qd is None else qd,
-                 w.zeros if qdd is None else qdd,
-                 w.zero_wrench if wrench is None else wrench, damping,
-                 flags, w.ws, w.cw, w.dw, res) < 0:
-            return res[0], res[1]
-    except Refused:
-        pass
-    except AttributeError:
-        foreign_workspace(model, ws)
-        raise
+    if (type(wrench) is not dict and type(q) is np.ndarray
+            and q.dtype is F64):    # lists, float32, link wrenches: below
+        try:
+            n = w.n
+            res = np.empty((2, n, n)) if out is None else out
+            damping = w.zeros if drives is None else drive_slopes(
+                drives, w.zeros if qd is None else qd, w.scratch[2])
+            if _dtau(model.packed, q, w.zeros if qd is None else qd,
+                     w.zeros if qdd is None else qdd,
+                     w.zero_wrench if wrench is None else wrench,
+                     damping, flags, w.ws, w.cw, w.dw, res) < 0:
+                return res[0], res[1]
+        except TypeError:
+            pass
+        except AttributeError:
+            foreign_workspace(model, ws)
+            raise
     return _converted(model, ws, INPUTS, (q, qd, qdd), wrench, wrench_frame,
                       flags, drives, out)
 
@@ -160,7 +159,8 @@ def forward_dynamics_derivatives(model, q, qd, tau, wrench=None,
     """
     w = model.default_workspace if ws is None else ws
     flags = _flags(gravity, wrench, wrench_frame)
-    if drives is None and type(wrench) is not dict:
+    if (drives is None and type(wrench) is not dict
+            and type(q) is np.ndarray and q.dtype is F64):
         try:
             n = w.n
             res = np.empty((3, n, n)) if out is None else out
@@ -169,7 +169,7 @@ def forward_dynamics_derivatives(model, q, qd, tau, wrench=None,
                      w.zeros, flags, w.ws, w.cw, w.dw, w.chol, w.scratch,
                      res) < 0:
                 return res[0], res[1], res[2]
-        except Refused:
+        except TypeError:
             pass
         except AttributeError:
             foreign_workspace(model, ws)
@@ -203,19 +203,21 @@ def _converted(model, ws, names, given, wrench, wrench_frame, flags, drives,
                                                   wrench_frame, ws)
         flags |= K.LINK_WRENCHES
         if forward:
-            code = _dqdd_links(model.packed, q, qd, third, ws.zero_wrench,
-                               fall, fext, wext, armature, damping, flags,
-                               ws.ws, ws.cw, ws.dw, ws.chol, ws.scratch, res)
+            code = _dqdd_links(
+                model.packed, q, qd, third, ws.zero_wrench, fall, fext, wext,
+                armature, damping, flags, ws.ws, ws.cw, ws.dw, ws.chol,
+                ws.scratch, res)
         else:
-            code = _dtau_links(model.packed, q, qd, third, ws.zero_wrench,
-                               fext, wext, damping, flags, ws.ws, ws.cw,
-                               ws.dw, res)
+            code = _dtau_links(
+                model.packed, q, qd, third, ws.zero_wrench, fext, wext,
+                damping, flags, ws.ws, ws.cw, ws.dw, res)
     elif forward:
-        code = _dqdd(model.packed, q, qd, third, w, armature, damping, flags,
-                     ws.ws, ws.cw, ws.dw, ws.chol, ws.scratch, res)
+        code = _dqdd(model.packed, q, qd, third, w, armature, damping,
+                     flags, ws.ws, ws.cw, ws.dw, ws.chol, ws.scratch,
+                     res)
     else:
-        code = _dtau(model.packed, q, qd, third, w, damping, flags, ws.ws,
-                     ws.cw, ws.dw, res)
+        code = _dtau(model.packed, q, qd, third, w, damping, flags,
+                     ws.ws, ws.cw, ws.dw, res)
     if code >= 0:
         raise status_error(code, (q, qd, third, w), names, model=model,
                            q=q, ws=ws)

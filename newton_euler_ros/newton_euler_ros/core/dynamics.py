@@ -54,9 +54,10 @@ Cost per call.  Each function calls a *strict entry* of its kernel
 (registered below, one line per term): a dispatcher compiled for exactly
 float64, C-contiguous arrays, so such arguments go straight in and the
 kernel checks sizes and finiteness itself, returning a status code.
-Anything else (lists, other dtypes, read-only or strided arrays) is
-refused by the dispatcher at once, converted once, and the call made
-again; every error is decoded in one place (``calling.status_error``).
+Lists and other dtypes are converted once before the call; read-only
+or strided arrays are refused by numba's dispatcher (its TypeError),
+then converted once and the call made again; every error is decoded in
+one place (``calling.status_error``).
 See :mod:`newton_euler_ros.core.calling`.
 
 Examples
@@ -75,11 +76,11 @@ from . import kernels as K
 from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
                     gravity_torques_batch, inverse_dynamics_batch,
                     mass_matrix_batch)
-from .calling import (bad_method, BOOL, CORIOLIS_METHODS, FD_INPUTS,
+from .calling import (bad_method, BOOL, CORIOLIS_METHODS, F64, FD_INPUTS,
                       first_singular_pivot, foreign_workspace,
                       FORWARD_DYNAMICS_METHODS, INPUTS, inputs, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
-                      out_array, PACKED, Refused, status_error, strict_entry,
+                      out_array, PACKED, status_error, strict_entry,
                       VEC, vector, workspace, wrench_mode)
 from .frames import (end_effector_pose, frame_pose, jacobian, link_poses,
                      link_wrench_rows, wrench_torques)
@@ -98,21 +99,25 @@ __all__ = [
 
 # ---------------------------------------------------------------------------
 # the strict entries: one registration per kernel entry point (argument
-# types as the entry point takes them; see calling.strict_entry)
+# types as the entry point takes them; see calling.strict_entry).  Each
+# name is rebound here to its numba dispatcher on its first call.
 
 _tau = strict_entry(K.run_inverse_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
-                    MAT, VEC)
-_gravity = strict_entry(K.run_gravity_torques, PACKED, VEC, MAT, VEC)
-_crba = strict_entry(K.run_mass_matrix_crba, PACKED, VEC, MAT, MAT)
-_mass = strict_entry(K.run_mass_matrix, PACKED, VEC, BOOL, MAT, MAT, MAT)
+                    MAT, VEC, home=globals())
+_gravity = strict_entry(K.run_gravity_torques, PACKED, VEC, MAT, VEC,
+                        home=globals())
+_crba = strict_entry(K.run_mass_matrix_crba, PACKED, VEC, MAT, MAT,
+                     home=globals())
+_mass = strict_entry(K.run_mass_matrix, PACKED, VEC, BOOL, MAT, MAT, MAT,
+                     home=globals())
 _coriolis = strict_entry(K.run_coriolis_matrix, PACKED, VEC, VEC, BOOL, MAT,
-                         MAT, MAT, MAT)
+                         MAT, MAT, MAT, home=globals())
 _aba = strict_entry(K.run_forward_dynamics, PACKED, VEC, VEC, VEC, VEC, INT,
-                    MAT, MAT, VEC)
+                    MAT, MAT, VEC, home=globals())
 _tau_links = strict_entry(K.run_inverse_dynamics_links, PACKED, VEC, VEC,
-                          VEC, VEC, MAT, INT, MAT, VEC)
+                          VEC, VEC, MAT, INT, MAT, VEC, home=globals())
 _aba_links = strict_entry(K.run_forward_dynamics_links, PACKED, VEC, VEC,
-                          VEC, VEC, MAT, INT, MAT, MAT, VEC)
+                          VEC, VEC, MAT, INT, MAT, MAT, VEC, home=globals())
 
 assert (K.GRAVITY, K.VELOCITY, K.WRENCH_SHIFT) == (1, 2, 2)  # literals below
 
@@ -167,9 +172,9 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
             return _tau_at_links(model, ws, q, qd, qdd, wrench, wrench_frame,
                                  flags, out)
         flags |= wrench_mode(wrench, wrench_frame) << 2
-    if type(q) is not np.ndarray or (wrench is not None
-                                     and type(wrench) is not np.ndarray):
-        # lists: converted at once, rather than refused first
+    if type(q) is not np.ndarray or q.dtype is not F64 or (
+            wrench is not None and type(wrench) is not np.ndarray):
+        # lists, float32: converted at once, not tried first
         return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
     try:
         tau = np.empty(w.n) if out is None else out
@@ -178,7 +183,7 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
                 w.zero_wrench if wrench is None else wrench, flags, w.ws,
                 tau) < 0:
             return tau
-    except (Refused, AttributeError) as exc:
+    except (TypeError, AttributeError) as exc:
         _fast_call_failed(exc, model, ws)
     return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
 
@@ -187,13 +192,14 @@ def _fast_call_failed(exc, model, ws):
     """
     Settle what a fast entry raised: return, or raise the right error.
 
-    Refused (an argument of another type or size) returns: the caller
-    converts its arguments and calls again, for the error that names
-    them.  An AttributeError is a ``ws`` that is not a Workspace (its
+    numba's TypeError (an argument of another type: a read-only or
+    strided array, a ``ws`` or ``out`` of another dtype) returns: the
+    caller converts its arguments and calls again, for the error that
+    names them.  An AttributeError is a ``ws`` that is not a Workspace (its
     one-line error), or else a bug, raised as it is.  Only the failing
     call comes here: the fast path costs no call more.
     """
-    if not isinstance(exc, Refused):
+    if not isinstance(exc, TypeError):
         foreign_workspace(model, ws)
         raise exc
 
@@ -214,7 +220,7 @@ def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
     tau = np.empty(n) if out is None else out
     try:
         code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
-    except Refused:
+    except TypeError:
         code = K.SIZE
     if code >= K.SIZE:      # another dtype or size of ws or out: say which
         workspace(model, ws)
@@ -245,7 +251,8 @@ def _tau_at_links(model, ws, q, qd, qdd, wrenches, wrench_frame, flags,
 def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
     w = model.default_workspace if ws is None else ws
-    if type(q) is not np.ndarray:   # a list: converted, not refused first
+    if type(q) is not np.ndarray or q.dtype is not F64:
+        # a list, float32: converted at once, not tried first
         ws = workspace(model, ws)
         q = inputs(ws, INPUTS, q)[0]
         tau = out_array(out, (ws.n,))
@@ -257,7 +264,7 @@ def gravity_torques(model, q, *, ws=None, out=None):
         tau = np.empty(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
-    except (Refused, AttributeError) as exc:
+    except (TypeError, AttributeError) as exc:
         _fast_call_failed(exc, model, ws)
     return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
 
@@ -281,13 +288,14 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
     times them).  Any other ``method`` raises ValueError.
     """
     if method == 'crba':
-        w = model.default_workspace if ws is None else ws
-        try:
-            D = np.empty((w.n, w.n)) if out is None else out
-            if _crba(model.packed, q, w.ws, D) < 0:
-                return D
-        except (Refused, AttributeError) as exc:
-            _fast_call_failed(exc, model, ws)
+        if type(q) is np.ndarray and q.dtype is F64:   # lists: below
+            w = model.default_workspace if ws is None else ws
+            try:
+                D = np.empty(w.square) if out is None else out
+                if _crba(model.packed, q, w.ws, D) < 0:
+                    return D
+            except (TypeError, AttributeError) as exc:
+                _fast_call_failed(exc, model, ws)
     elif method != 'newton_euler':
         raise bad_method(method)
     ws = workspace(model, ws)
@@ -334,14 +342,16 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
         composite = False
     else:
         raise bad_method(method, CORIOLIS_METHODS)
-    w = model.default_workspace if ws is None else ws
-    try:
-        C = np.empty((w.n, w.n)) if out is None else out
-        if _coriolis(model.packed, q, qd, composite, w.ws, w.cw, w.scratch,
-                     C) < 0:
-            return C
-    except (Refused, AttributeError) as exc:
-        _fast_call_failed(exc, model, ws)
+    if (type(q) is np.ndarray and q.dtype is F64
+            and type(qd) is np.ndarray):    # lists: below
+        w = model.default_workspace if ws is None else ws
+        try:
+            C = np.empty(w.square) if out is None else out
+            if _coriolis(model.packed, q, qd, composite, w.ws, w.cw,
+                         w.scratch, C) < 0:
+                return C
+        except (TypeError, AttributeError) as exc:
+            _fast_call_failed(exc, model, ws)
     ws = workspace(model, ws)
     n = ws.n
     q, qd = vector('q', q, n), vector('qd', qd, n)
@@ -383,9 +393,9 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
         method = 'cholesky'
     if method == 'aba':
         w = model.default_workspace if ws is None else ws
-        if type(q) is not np.ndarray or (wrench is not None
-                                         and type(wrench) is not np.ndarray):
-            # lists: converted at once, rather than refused first
+        if type(q) is not np.ndarray or q.dtype is not F64 or (
+                wrench is not None and type(wrench) is not np.ndarray):
+            # lists, float32: converted at once, not tried first
             return _aba_converted(model, ws, q, qd, tau, wrench,
                                   wrench_frame, flags, out)
         try:
@@ -394,7 +404,7 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                     w.zero_wrench if wrench is None else wrench, flags,
                     w.ws, w.aw, qdd) < 0:
                 return qdd
-        except (Refused, AttributeError) as exc:
+        except (TypeError, AttributeError) as exc:
             _fast_call_failed(exc, model, ws)
         return _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame,
                               flags, out)

@@ -44,8 +44,8 @@ AXES = ('base', 'link')         # of a named frame's Jacobian and wrench
 OLD_AXES = {'base': False, END_EFFECTOR: True}   # frame= of the end effector
 
 _jac = strict_entry(K.run_jacobian, PACKED, VEC, INT, TARGET, BOOL, MAT, MAT,
-                    MAT)
-_poses = strict_entry(K.run_link_poses, PACKED, VEC, MAT, MAT)
+                    MAT, home=globals())
+_poses = strict_entry(K.run_link_poses, PACKED, VEC, MAT, MAT, home=globals())
 
 
 def _readonly(x):

@@ -40,6 +40,7 @@ class Workspace:
         nb = model.nb
         self.n = n              # coordinates (independent joints)
         self.nb = nb            # moving joints (bodies), mimic ones too
+        self.square = (n, n)    # the shape of D and C
         self.dtype = np.dtype(dtype)
         self.ws = np.zeros((nb, K.W_WIDTH), dtype)
         self.scratch = np.zeros((3, n), dtype)

@@ -13,47 +13,163 @@
 # limitations under the License.
 
 """
-The strict entries' hold on numba (``core.calling.strict_entry``).
+The strict entries (``core.calling.StrictEntry``) and numba's public API.
 
-A strict entry is compiled for one signature and answers any other
-argument type by raising ``Refused`` at once; it does so through two of
-numba's private dispatcher callbacks (numba is pinned for that reason).
-A numba that renamed them would silently go back to its slow search for
-conversions (about 100 us a call, measured in docs/performance.md) or
-compile a new signature per argument type: these tests fail first.
+A strict entry is compiled for one signature on its first call and then
+closed to others, so numba answers any other argument type with its
+``TypeError`` and never compiles a variant.  It uses only numba's public
+dispatcher API.  The package's source names none of numba's private
+dispatcher or cache members but one: the content stamps of the kernel
+cache (``core/kernels/_jit.py``), for which numba has no public hook
+(without it a fresh clone would recompile every kernel, numba stamping a
+cached function by its file's modification time); a numba without it
+falls back to numba's own stamps, and a test here says so.
 """
-from newton_euler_ros.core import (calling, gravity_torques, load_robot,
+import ast
+import pathlib
+import threading
+
+from newton_euler_ros.core import (calling, gravity_torques,
+                                   inverse_dynamics, load_robot, mass_matrix,
                                    Workspace)
 from newton_euler_ros.core import kernels as K
-from numba.core.dispatcher import Dispatcher
+from newton_euler_ros.core.observer import external_wrench, MomentumObserver
+import numba
+from numba.core import caching, dispatcher
 import numpy as np
 import pytest
 
-
-def test_numba_still_has_the_callbacks_strict_entries_replace():
-    for name in ('_compile_for_args', '_search_new_conversions'):
-        assert callable(getattr(Dispatcher, name, None)), (
-            f'numba.core.dispatcher.Dispatcher has no {name}: '
-            f'core/calling.py strict_entry must be rewritten for this numba')
+PACKAGE = pathlib.Path(calling.__file__).resolve().parents[1]
+# (file, name): the one private use, with the reason above
+ALLOWED = {('core/kernels/_jit.py', '_locator_classes')}
 
 
-def test_one_signature_and_every_other_type_refused():
+def _private_numba_names():
+    """Every single-underscore member of numba's dispatcher and caching."""
+    names = set()
+    for module in (dispatcher, caching):
+        for obj in vars(module).values():
+            if isinstance(obj, type) and obj.__module__ == module.__name__:
+                names |= {n for n in vars(obj)
+                          if n.startswith('_') and not n.startswith('__')}
+        names |= {n for n in vars(module)
+                  if n.startswith('_') and not n.startswith('__')}
+    # names every Python object or our own classes have too
+    return names - {'_abc_impl', '_lock', '_cache'}
+
+
+def test_the_package_uses_no_private_numba_name():
+    private = _private_numba_names()
+    assert '_compile_for_args' in private       # the scan sees them
+    assert '_search_new_conversions' in private
+    found = []
+    for path in sorted(PACKAGE.rglob('*.py')):
+        tree = ast.parse(path.read_text(), str(path))
+        for node in ast.walk(tree):
+            name = None
+            if isinstance(node, ast.Attribute):
+                name = node.attr
+            elif isinstance(node, ast.Constant) and isinstance(node.value,
+                                                               str):
+                name = node.value       # getattr(x, '_name')
+            where = path.relative_to(PACKAGE).as_posix()
+            if name in private and (where, name) not in ALLOWED:
+                found.append(f'{where}:{node.lineno} {name}')
+    assert not found, f'numba private names used: {found}'
+
+
+def test_numba_still_has_the_cache_hook_the_kernel_stamps_use():
+    impl = getattr(caching, 'CacheImpl', None) or getattr(
+        caching, '_CacheImpl', None)
+    classes = getattr(impl, '_locator_classes', None)
+    assert classes is not None, (
+        'numba.core.caching has no _locator_classes: core/kernels/_jit.py '
+        "falls back to numba's own stamps (a fresh clone recompiles)")
+    assert any(c.__name__.startswith('KernelPackage') for c in classes)
+
+
+def _gravity_entry(home=None):
+    return calling.StrictEntry(K.run_gravity_torques, calling.PACKED,
+                               calling.VEC, calling.MAT, calling.VEC,
+                               home=home)
+
+
+def test_one_signature_compiled_on_first_call_and_every_other_type_refused():
     arm = load_robot('puma560')
     ws = Workspace(arm)
-    entry = calling.strict_entry(K.run_gravity_torques, calling.PACKED,
-                                 calling.VEC, calling.MAT, calling.VEC)
+    home = {}
+    home['entry'] = entry = _gravity_entry(home)
+    assert entry.dispatcher is None             # nothing made yet
     q = np.linspace(-1.0, 1.0, arm.n)
     tau = np.empty(arm.n)
     assert entry(arm.packed, q, ws.ws, tau) == -1
+    # the name now holds numba's dispatcher itself
+    assert home['entry'] is entry.dispatcher
+    assert isinstance(home['entry'], numba.core.registry.CPUDispatcher)
     # the same torques as the public call
     np.testing.assert_array_equal(tau, gravity_torques(arm, q))
-    assert len(entry.signatures) == 1
+    assert len(entry.dispatcher.signatures) == 1
     read_only = q.copy()
     read_only.setflags(write=False)
     for bad in (list(q), q.astype(np.float32), np.repeat(q, 2)[::2],
                 read_only, q.astype(np.int64), q.reshape(1, -1)):
-        with pytest.raises(calling.Refused):
-            entry(arm.packed, bad, ws.ws, tau)
-    with pytest.raises(calling.Refused):
-        entry(arm.packed, q, ws.ws, np.empty(arm.n, np.float32))
-    assert len(entry.signatures) == 1, 'a miss compiled a new signature'
+        with pytest.raises(TypeError):
+            home['entry'](arm.packed, bad, ws.ws, tau)
+    with pytest.raises(TypeError):
+        home['entry'](arm.packed, q, ws.ws, np.empty(arm.n, np.float32))
+    assert len(entry.dispatcher.signatures) == 1, 'a miss compiled another'
+
+
+def test_a_first_call_of_another_type_still_compiles_the_one_signature():
+    arm = load_robot('puma560')
+    ws = Workspace(arm)
+    entry = _gravity_entry()
+    with pytest.raises(TypeError):
+        entry(arm.packed, [0.0] * arm.n, ws.ws, np.empty(arm.n))
+    assert [str(t) for t in entry.dispatcher.signatures[0]] == [
+        str(t) for t in entry.signature.args]
+
+
+def test_threads_loading_one_entry_at_once_make_one_dispatcher():
+    entry = _gravity_entry()
+    got = []
+    threads = [threading.Thread(target=lambda: got.append(entry.load()))
+               for _ in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len({id(d) for d in got}) == 1 and got[0] is entry.dispatcher
+
+
+def test_the_public_calls_run_numba_dispatchers_once_loaded():
+    from newton_euler_ros.core import dynamics
+    arm = load_robot('puma560')
+    mass_matrix(arm, np.zeros(arm.n))
+    assert isinstance(dynamics._crba, numba.core.registry.CPUDispatcher)
+
+
+@pytest.mark.parametrize('make', [
+    lambda q: q.copy(),
+    lambda q: list(q),
+    lambda q: tuple(q),
+    lambda q: q.astype(np.float32),
+    lambda q: np.repeat(q, 2)[::2],                 # strided
+    lambda q: np.frombuffer(q.tobytes()),           # read-only
+])
+def test_every_input_form_gives_the_same_bits(make):
+    arm = load_robot('puma560')
+    q = np.linspace(-1.0, 1.0, arm.n)
+    qd = np.linspace(0.5, -0.5, arm.n)
+    r = np.linspace(1.0, 2.0, arm.n)
+    # values float32 holds exactly, so every form means the same numbers
+    q, qd, r = (x.astype(np.float32).astype(np.float64) for x in (q, qd, r))
+    expected = (inverse_dynamics(arm, q, qd, qd), mass_matrix(arm, q))
+    got = (inverse_dynamics(arm, make(q), make(qd), make(qd)),
+           mass_matrix(arm, make(q)))
+    for e, g in zip(expected, got):
+        assert g.dtype == np.float64
+        np.testing.assert_array_equal(g, e)
+    obs = MomentumObserver(arm, gain=50.0)
+    np.testing.assert_array_equal(external_wrench(obs, make(q), make(r)),
+                                  external_wrench(obs, q, r))

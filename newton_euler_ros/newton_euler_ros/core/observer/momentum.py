@@ -80,7 +80,7 @@ import numpy as np
 
 from .contact import contact_step, initial_contact
 from .wrench import external_wrench
-from ..calling import (F8, MAT, PACKED, Refused, status_error,
+from ..calling import (F64, F8, MAT, PACKED, status_error,
                        strict_entry, VEC, vector, workspace)
 from ..drives import DEFAULT_COULOMB_WIDTH
 from ..errors import DynamicsInputError
@@ -178,7 +178,7 @@ def _step(P, q, qd, tau, lost, dt, ws, cw, buf, S, r, beta_prev, fric):
 
 
 _step_strict = strict_entry(_step, PACKED, VEC, VEC, VEC, VEC, F8, MAT, MAT,
-                            MAT, VEC, VEC, VEC, MAT)
+                            MAT, VEC, VEC, VEC, MAT, home=globals())
 
 
 # ---------------------------------------------------------------------------
@@ -442,12 +442,15 @@ def observer_step(obs, state, t, q, qd, tau):
     else:
         qd = _vector('qd', qd, obs.n)
         lost = _vector('drive_torque', obs.drive_torque(qd, None), obs.n)
-    try:
-        code = _step_strict(obs._packed, q, qd, tau, lost, dt, obs.ws.ws,
-                            obs.ws.cw, obs._buf, state.S, state.r,
-                            state.beta_prev, state.friction)
-    except Refused:                 # not float64 arrays: convert, again
-        code = None
+    code = None
+    if (type(q) is np.ndarray and q.dtype is F64 and type(qd) is np.ndarray
+            and type(tau) is np.ndarray):   # lists: converted below
+        try:
+            code = _step_strict(obs._packed, q, qd, tau, lost, dt,
+                                obs.ws.ws, obs.ws.cw, obs._buf, state.S,
+                                state.r, state.beta_prev, state.friction)
+        except TypeError:           # read-only, strided: convert, again
+            pass
     if code is None or code >= 0:
         _step_converted(obs, state, q, qd, tau, lost, dt)
     if what is RESTARTED:
@@ -463,10 +466,11 @@ def _step_converted(obs, state, q, qd, tau, lost, dt):
     q, qd, tau = (vector(k, x, n) for k, x in
                   (('q', q), ('qd', qd), ('tau', tau)))
     try:
-        code = _step_strict(obs._packed, q, qd, tau, vector('lost', lost, n),
-                            dt, obs.ws.ws, obs.ws.cw, obs._buf, state.S,
-                            state.r, state.beta_prev, state.friction)
-    except Refused:
+        code = _step_strict(obs._packed, q, qd, tau,
+                            vector('lost', lost, n), dt, obs.ws.ws,
+                            obs.ws.cw, obs._buf, state.S, state.r,
+                            state.beta_prev, state.friction)
+    except TypeError:
         raise DynamicsInputError('state: not made by initial_state') from None
     if code < 0:
         return

@@ -34,7 +34,7 @@ import math
 from numba import njit
 import numpy as np
 
-from ..calling import (BOOL, F8, INT, MAT, out_array, PACKED, Refused,
+from ..calling import (BOOL, F64, F8, INT, MAT, out_array, PACKED,
                        status_error, strict_entry, TARGET, VEC, vector)
 from ..dynamics import jacobian
 from ..errors import DynamicsInputError
@@ -139,9 +139,10 @@ def _wrench_at(P, q, r, damping, body, target, local, ws, Ts, J, A, y, F):
 
 
 _wrench_strict = strict_entry(_wrench, PACKED, VEC, VEC, F8, MAT, MAT, MAT,
-                              MAT, VEC, VEC)
+                              MAT, VEC, VEC, home=globals())
 _wrench_at_strict = strict_entry(_wrench_at, PACKED, VEC, VEC, F8, INT,
-                                 TARGET, BOOL, MAT, MAT, MAT, MAT, VEC, VEC)
+                                 TARGET, BOOL, MAT, MAT, MAT, MAT, VEC, VEC,
+                                 home=globals())
 
 
 def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
@@ -164,12 +165,16 @@ def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
     """
     if frame is not None:
         return _wrench_at_frame(obs, q, r, out, frame, axes)
-    F = np.empty(6) if out is None else out
-    try:
-        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
-                              obs.ws.frames, obs.J, obs._A, obs._y, F)
-    except Refused:                 # not float64 arrays: convert, again
-        code = None
+    code = None
+    if (type(q) is np.ndarray and q.dtype is F64
+            and type(r) is np.ndarray):     # lists: converted below
+        F = np.empty(6) if out is None else out
+        try:
+            code = _wrench_strict(obs._packed, q, r, obs.damping,
+                                  obs.ws.ws, obs.ws.frames, obs.J,
+                                  obs._A, obs._y, F)
+        except TypeError:           # read-only, strided: convert, again
+            pass
     if code is None or code >= 0:
         q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
             out, (6,))
@@ -205,13 +210,17 @@ def _wrench_at_frame(obs, q, r, out, frame, axes):
                                  f'{axes!r}')
     body, target = frame_target(obs.model, frame)
     local = axes == 'link'
-    F = np.empty(6) if out is None else out
-    try:
-        code = _wrench_at_strict(obs._packed, q, r, obs.damping, body,
-                                 target, local, obs.ws.ws, obs.ws.frames,
-                                 obs.J, obs._A, obs._y, F)
-    except Refused:                 # not float64 arrays: convert, again
-        code = None
+    code = None
+    if (type(q) is np.ndarray and q.dtype is F64
+            and type(r) is np.ndarray):     # lists: converted below
+        F = np.empty(6) if out is None else out
+        try:
+            code = _wrench_at_strict(obs._packed, q, r, obs.damping,
+                                     body, target, local, obs.ws.ws,
+                                     obs.ws.frames, obs.J, obs._A,
+                                     obs._y, F)
+        except TypeError:           # read-only, strided: convert, again
+            pass
     if code is None or code >= 0:
         q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
             out, (6,))
