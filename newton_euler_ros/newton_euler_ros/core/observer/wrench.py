@@ -165,21 +165,30 @@ def external_wrench(obs, q, r, out=None, frame=None, axes='base'):
     """
     if frame is not None:
         return _wrench_at_frame(obs, q, r, out, frame, axes)
+    return _solved(_wrench_strict, obs, q, r, out)
+
+
+def _solved(entry, obs, q, r, out, *frame):
+    """
+    Return the wrench one entry solves for; convert the inputs if refused.
+
+    ``frame``: the entry's frame arguments (body, target, local axes),
+    between the damping and the workspace; none for the end effector.
+    """
     code = None
     if (type(q) is np.ndarray and q.dtype is F64
             and type(r) is np.ndarray):     # lists: converted below
         F = np.empty(6) if out is None else out
         try:
-            code = _wrench_strict(obs._packed, q, r, obs.damping,
-                                  obs.ws.ws, obs.ws.frames, obs.J,
-                                  obs._A, obs._y, F)
+            code = entry(obs._packed, q, r, obs.damping, *frame, obs.ws.ws,
+                         obs.ws.frames, obs.J, obs._A, obs._y, F)
         except TypeError:           # read-only, strided: convert, again
             pass
     if code is None or code >= 0:
         q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
             out, (6,))
-        code = _wrench_strict(obs._packed, q, r, obs.damping, obs.ws.ws,
-                              obs.ws.frames, obs.J, obs._A, obs._y, F)
+        code = entry(obs._packed, q, r, obs.damping, *frame, obs.ws.ws,
+                     obs.ws.frames, obs.J, obs._A, obs._y, F)
         if code >= 0:
             raise status_error(code, (q,))
     return F
@@ -209,24 +218,5 @@ def _wrench_at_frame(obs, q, r, out, frame, axes):
         raise DynamicsInputError(f"axes must be 'base' or 'link', got "
                                  f'{axes!r}')
     body, target = frame_target(obs.model, frame)
-    local = axes == 'link'
-    code = None
-    if (type(q) is np.ndarray and q.dtype is F64
-            and type(r) is np.ndarray):     # lists: converted below
-        F = np.empty(6) if out is None else out
-        try:
-            code = _wrench_at_strict(obs._packed, q, r, obs.damping,
-                                     body, target, local, obs.ws.ws,
-                                     obs.ws.frames, obs.J, obs._A,
-                                     obs._y, F)
-        except TypeError:           # read-only, strided: convert, again
-            pass
-    if code is None or code >= 0:
-        q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
-            out, (6,))
-        code = _wrench_at_strict(obs._packed, q, r, obs.damping, body,
-                                 target, local, obs.ws.ws, obs.ws.frames,
-                                 obs.J, obs._A, obs._y, F)
-        if code >= 0:
-            raise status_error(code, (q,))
-    return F
+    return _solved(_wrench_at_strict, obs, q, r, out, body, target,
+                   axes == 'link')
