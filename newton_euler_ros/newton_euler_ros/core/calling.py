@@ -38,12 +38,14 @@ costs one conversion more.  Only numba's public API is used: ``njit``,
 import gc
 import math
 import threading
+import warnings
 
 from numba import njit, types
 import numpy as np
 
 from . import kernels as K
-from .errors import DynamicsInputError, NotPositiveDefiniteError
+from .errors import (DynamicsInputError, NotPositiveDefiniteError,
+                     SlowInputWarning)
 from .workspace import Workspace
 
 # numba and the kernels' dispatchers are some 200,000 objects that live as
@@ -130,6 +132,43 @@ class StrictEntry:
 
 
 strict_entry = StrictEntry
+
+
+_SLOW_SAID = []     # the warning below is given once a process
+
+
+def slow_inputs(values, names=INPUTS, stacklevel=3):
+    """
+    Warn, once a process, of an input numba's dispatcher did not take.
+
+    Called where a fast call raised numba's ``TypeError``: if one of the
+    ``values`` is the cause (a read-only or strided float64 array, or a
+    sequence beside arrays), numba's search for a conversion cost about
+    0.1 ms, and will on every call given such an input.  The result is
+    right all the same; the warning says which input and what to pass.
+    ``stacklevel``: the user's call, counted as ``warnings.warn`` does
+    from this function (3: the caller's caller).
+    """
+    if _SLOW_SAID:
+        return
+    for name, x in zip(names, values):
+        if type(x) is np.ndarray:
+            if x.flags.writeable and x.flags.c_contiguous:
+                continue
+            what = ('a read-only array' if not x.flags.writeable
+                    else 'a strided (not C-contiguous) array')
+        elif type(x) in SEQUENCES:
+            what = f'a {type(x).__name__} beside arrays'
+        else:
+            continue
+        _SLOW_SAID.append(name)
+        warnings.warn(
+            f'{name} is {what}: numba looks for a conversion before it is '
+            f'converted, about 0.1 ms more on every such call (the result '
+            f'is the same); pass a writeable, C-contiguous float64 array, '
+            f'e.g. np.array({name}, dtype=float). Said once',
+            SlowInputWarning, stacklevel=stacklevel)
+        return
 
 
 # ---------------------------------------------------------------------------

@@ -50,8 +50,9 @@ import numpy as np
 from . import kernels as K
 from .batch import run_split
 from .calling import (F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
-                      INT, MAT, matrix, out_array, PACKED, status_error,
-                      strict_entry, VEC, vector, workspace, wrench_mode)
+                      INT, MAT, matrix, out_array, PACKED, slow_inputs,
+                      status_error, strict_entry, VEC, vector, workspace,
+                      wrench_mode)
 from .frames import derivative_wrench_rows
 
 __all__ = ['forward_dynamics_derivatives',
@@ -130,7 +131,7 @@ def inverse_dynamics_derivatives(model, q, qd=None, qdd=None, wrench=None,
                      damping, flags, w.ws, w.cw, w.dw, res) < 0:
                 return res[0], res[1]
         except TypeError:
-            pass
+            slow_inputs((q, qd, qdd, wrench))
         except AttributeError:
             foreign_workspace(model, ws)
             raise
@@ -170,7 +171,7 @@ def forward_dynamics_derivatives(model, q, qd, tau, wrench=None,
                      res) < 0:
                 return res[0], res[1], res[2]
         except TypeError:
-            pass
+            slow_inputs((q, qd, tau, wrench), FD_INPUTS)
         except AttributeError:
             foreign_workspace(model, ws)
             raise

@@ -80,8 +80,8 @@ from .calling import (bad_method, BOOL, CORIOLIS_METHODS, F64, FD_INPUTS,
                       first_singular_pivot, foreign_workspace,
                       FORWARD_DYNAMICS_METHODS, INPUTS, inputs, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
-                      out_array, PACKED, status_error, strict_entry,
-                      VEC, vector, workspace, wrench_mode)
+                      out_array, PACKED, slow_inputs, status_error,
+                      strict_entry, VEC, vector, workspace, wrench_mode)
 from .frames import (end_effector_pose, frame_pose, jacobian, link_poses,
                      link_wrench_rows, wrench_torques)
 from .workspace import Workspace
@@ -184,11 +184,11 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
                 tau) < 0:
             return tau
     except (TypeError, AttributeError) as exc:
-        _fast_call_failed(exc, model, ws)
+        _fast_call_failed(exc, model, ws, (q, qd, qdd, wrench))
     return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
 
 
-def _fast_call_failed(exc, model, ws):
+def _fast_call_failed(exc, model, ws, values=(), names=INPUTS):
     """
     Settle what a fast entry raised: return, or raise the right error.
 
@@ -202,6 +202,7 @@ def _fast_call_failed(exc, model, ws):
     if not isinstance(exc, TypeError):
         foreign_workspace(model, ws)
         raise exc
+    slow_inputs(values, names, stacklevel=4)
 
 
 def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
@@ -265,7 +266,7 @@ def gravity_torques(model, q, *, ws=None, out=None):
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
     except (TypeError, AttributeError) as exc:
-        _fast_call_failed(exc, model, ws)
+        _fast_call_failed(exc, model, ws, (q,))
     return _tau_converted(model, ws, q, None, None, None, K.GRAVITY, out)
 
 
@@ -295,7 +296,7 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
                 if _crba(model.packed, q, w.ws, D) < 0:
                     return D
             except (TypeError, AttributeError) as exc:
-                _fast_call_failed(exc, model, ws)
+                _fast_call_failed(exc, model, ws, (q,))
     elif method != 'newton_euler':
         raise bad_method(method)
     ws = workspace(model, ws)
@@ -351,7 +352,7 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
                          w.scratch, C) < 0:
                 return C
         except (TypeError, AttributeError) as exc:
-            _fast_call_failed(exc, model, ws)
+            _fast_call_failed(exc, model, ws, (q, qd))
     ws = workspace(model, ws)
     n = ws.n
     q, qd = vector('q', q, n), vector('qd', qd, n)
@@ -405,7 +406,8 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
                     w.ws, w.aw, qdd) < 0:
                 return qdd
         except (TypeError, AttributeError) as exc:
-            _fast_call_failed(exc, model, ws)
+            _fast_call_failed(exc, model, ws, (q, qd, tau, wrench),
+                              FD_INPUTS)
         return _aba_converted(model, ws, q, qd, tau, wrench, wrench_frame,
                               flags, out)
     if method != 'cholesky':

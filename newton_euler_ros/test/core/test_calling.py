@@ -28,11 +28,13 @@ falls back to numba's own stamps, and a test here says so.
 import ast
 import pathlib
 import threading
+import warnings
 
 from newton_euler_ros.core import (calling, gravity_torques,
                                    inverse_dynamics, load_robot, mass_matrix,
                                    Workspace)
 from newton_euler_ros.core import kernels as K
+from newton_euler_ros.core.errors import SlowInputWarning
 from newton_euler_ros.core.observer import external_wrench, MomentumObserver
 import numba
 from numba.core import caching, dispatcher
@@ -149,6 +151,8 @@ def test_the_public_calls_run_numba_dispatchers_once_loaded():
     assert isinstance(dynamics._crba, numba.core.registry.CPUDispatcher)
 
 
+@pytest.mark.filterwarnings('ignore::newton_euler_ros.core.errors.'
+                            'SlowInputWarning')
 @pytest.mark.parametrize('make', [
     lambda q: q.copy(),
     lambda q: list(q),
@@ -173,3 +177,24 @@ def test_every_input_form_gives_the_same_bits(make):
     obs = MomentumObserver(arm, gain=50.0)
     np.testing.assert_array_equal(external_wrench(obs, make(q), make(r)),
                                   external_wrench(obs, q, r))
+
+
+def test_an_input_numba_refuses_is_named_once_and_gives_the_same_result(
+        monkeypatch):
+    monkeypatch.setattr(calling, '_SLOW_SAID', [])
+    arm = load_robot('puma560')
+    q = np.linspace(-1.0, 1.0, arm.n)
+    read_only = np.frombuffer(q.tobytes())
+    with pytest.warns(SlowInputWarning, match=r'^q is a read-only array'):
+        got = inverse_dynamics(arm, read_only, q)
+    np.testing.assert_array_equal(got, inverse_dynamics(arm, q, q))
+    with warnings.catch_warnings():
+        warnings.simplefilter('error')
+        inverse_dynamics(arm, read_only, q)         # said once
+        monkeypatch.setattr(calling, '_SLOW_SAID', [])
+        # converted before any try: nothing to say
+        inverse_dynamics(arm, list(q), q)
+        inverse_dynamics(arm, q.astype(np.float32), q)
+        mass_matrix(arm, list(q))
+    with pytest.warns(SlowInputWarning, match=r'^qd is a strided'):
+        inverse_dynamics(arm, q, np.repeat(q, 2)[::2])

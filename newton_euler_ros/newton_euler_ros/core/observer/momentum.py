@@ -80,8 +80,8 @@ import numpy as np
 
 from .contact import contact_step, initial_contact
 from .wrench import external_wrench
-from ..calling import (F64, F8, MAT, PACKED, status_error,
-                       strict_entry, VEC, vector, workspace)
+from ..calling import (F64, F8, MAT, PACKED, slow_inputs,
+                       status_error, strict_entry, VEC, vector, workspace)
 from ..drives import DEFAULT_COULOMB_WIDTH
 from ..errors import DynamicsInputError
 from ..kernels import NONFINITE, run_momentum_terms, SIZE
@@ -450,7 +450,7 @@ def observer_step(obs, state, t, q, qd, tau):
                                 obs.ws.ws, obs.ws.cw, obs._buf, state.S,
                                 state.r, state.beta_prev, state.friction)
         except TypeError:           # read-only, strided: convert, again
-            pass
+            slow_inputs((q, qd, tau), ('q', 'qd', 'tau'))
     if code is None or code >= 0:
         _step_converted(obs, state, q, qd, tau, lost, dt)
     if what is RESTARTED:

@@ -35,7 +35,8 @@ from numba import njit
 import numpy as np
 
 from ..calling import (BOOL, F64, F8, INT, MAT, out_array, PACKED,
-                       status_error, strict_entry, TARGET, VEC, vector)
+                       slow_inputs, status_error, strict_entry, TARGET, VEC,
+                       vector)
 from ..dynamics import jacobian
 from ..errors import DynamicsInputError
 from ..frames import AXES, frame_target
@@ -183,7 +184,7 @@ def _solved(entry, obs, q, r, out, *frame):
             code = entry(obs._packed, q, r, obs.damping, *frame, obs.ws.ws,
                          obs.ws.frames, obs.J, obs._A, obs._y, F)
         except TypeError:           # read-only, strided: convert, again
-            pass
+            slow_inputs((q, r), ('q', 'r'), stacklevel=4)
     if code is None or code >= 0:
         q, r, F = vector('q', q, obs.n), vector('r', r, obs.n), out_array(
             out, (6,))
