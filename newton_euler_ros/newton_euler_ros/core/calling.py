@@ -21,11 +21,13 @@ The one entry path of every dynamics function is
    (:class:`StrictEntry`), a numba dispatcher compiled for exactly
    float64, C-contiguous, writeable arrays and allowed no other
    signature.  numba matches argument types in C on every call anyway;
-   a main input that is not a float64 ndarray (a list, a float32 array)
-   skips this step on one check of its type and dtype in Python, and
-   anything else numba does not match (a read-only or strided array, a
+   a main input that is not an ndarray (a list) skips this step on one
+   check of its type in Python (and, where a call costs microseconds,
+   the derivatives and the observer, of its dtype too); anything else
+   numba does not match (a float32, int, read-only or strided array, a
    workspace of another dtype) raises numba's ``TypeError``, after
-   numba's own search for a conversion: about 0.1 ms;
+   numba's own search for a conversion: about 0.1 ms, and the first
+   such call in a process warns (:func:`slow_inputs`);
 2. only then, or when the kernel returns a status code: the arguments
    converted once (:func:`vector`, :func:`out_array`,
    :func:`workspace`), the kernel called again, and its status decoded
@@ -142,8 +144,8 @@ def slow_inputs(values, names=INPUTS, stacklevel=3):
     Warn, once a process, of an input numba's dispatcher did not take.
 
     Called where a fast call raised numba's ``TypeError``: if one of the
-    ``values`` is the cause (a read-only or strided float64 array, or a
-    sequence beside arrays), numba's search for a conversion cost about
+    ``values`` is the cause (an array of another dtype, a read-only or
+    strided one, or a sequence beside arrays), numba's search for a conversion cost about
     0.1 ms, and will on every call given such an input.  The result is
     right all the same; the warning says which input and what to pass.
     ``stacklevel``: the user's call, counted as ``warnings.warn`` does
@@ -153,10 +155,14 @@ def slow_inputs(values, names=INPUTS, stacklevel=3):
         return
     for name, x in zip(names, values):
         if type(x) is np.ndarray:
-            if x.flags.writeable and x.flags.c_contiguous:
+            if x.dtype != _F64:
+                what = f'a {x.dtype} array'
+            elif not x.flags.writeable:
+                what = 'a read-only array'
+            elif not x.flags.c_contiguous:
+                what = 'a strided (not C-contiguous) array'
+            else:
                 continue
-            what = ('a read-only array' if not x.flags.writeable
-                    else 'a strided (not C-contiguous) array')
         elif type(x) in SEQUENCES:
             what = f'a {type(x).__name__} beside arrays'
         else:

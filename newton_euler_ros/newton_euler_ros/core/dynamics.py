@@ -54,9 +54,10 @@ Cost per call.  Each function calls a *strict entry* of its kernel
 (registered below, one line per term): a dispatcher compiled for exactly
 float64, C-contiguous arrays, so such arguments go straight in and the
 kernel checks sizes and finiteness itself, returning a status code.
-Lists and other dtypes are converted once before the call; read-only
-or strided arrays are refused by numba's dispatcher (its TypeError),
-then converted once and the call made again; every error is decoded in
+Lists (and, for tau, g and forward dynamics, arrays of another dtype)
+are converted once before the call; anything else numba's dispatcher
+does not take (a read-only or strided array) is refused by it (its
+TypeError), then converted once and the call made again; every error is decoded in
 one place (``calling.status_error``).
 See :mod:`newton_euler_ros.core.calling`.
 
@@ -174,7 +175,7 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
         flags |= wrench_mode(wrench, wrench_frame) << 2
     if type(q) is not np.ndarray or q.dtype is not F64 or (
             wrench is not None and type(wrench) is not np.ndarray):
-        # lists, float32: converted at once, not tried first
+        # lists, int arrays: converted at once, not tried first
         return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
     try:
         tau = np.empty(w.n) if out is None else out
@@ -253,7 +254,7 @@ def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
     w = model.default_workspace if ws is None else ws
     if type(q) is not np.ndarray or q.dtype is not F64:
-        # a list, float32: converted at once, not tried first
+        # a list, an int array: converted at once, not tried first
         ws = workspace(model, ws)
         q = inputs(ws, INPUTS, q)[0]
         tau = out_array(out, (ws.n,))
@@ -289,7 +290,7 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
     times them).  Any other ``method`` raises ValueError.
     """
     if method == 'crba':
-        if type(q) is np.ndarray and q.dtype is F64:   # lists: below
+        if type(q) is np.ndarray:   # lists: below
             w = model.default_workspace if ws is None else ws
             try:
                 D = np.empty(w.square) if out is None else out
@@ -343,8 +344,7 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
         composite = False
     else:
         raise bad_method(method, CORIOLIS_METHODS)
-    if (type(q) is np.ndarray and q.dtype is F64
-            and type(qd) is np.ndarray):    # lists: below
+    if type(q) is np.ndarray:   # lists: below
         w = model.default_workspace if ws is None else ws
         try:
             C = np.empty(w.square) if out is None else out
@@ -396,7 +396,7 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
         w = model.default_workspace if ws is None else ws
         if type(q) is not np.ndarray or q.dtype is not F64 or (
                 wrench is not None and type(wrench) is not np.ndarray):
-            # lists, float32: converted at once, not tried first
+            # lists, int arrays: converted at once, not tried first
             return _aba_converted(model, ws, q, qd, tau, wrench,
                                   wrench_frame, flags, out)
         try:

@@ -192,9 +192,11 @@ def test_an_input_numba_refuses_is_named_once_and_gives_the_same_result(
         warnings.simplefilter('error')
         inverse_dynamics(arm, read_only, q)         # said once
         monkeypatch.setattr(calling, '_SLOW_SAID', [])
-        # converted before any try: nothing to say
-        inverse_dynamics(arm, list(q), q)
-        inverse_dynamics(arm, q.astype(np.float32), q)
+        # lists are converted before any try: nothing to say
+        inverse_dynamics(arm, list(q), list(q))
         mass_matrix(arm, list(q))
     with pytest.warns(SlowInputWarning, match=r'^qd is a strided'):
         inverse_dynamics(arm, q, np.repeat(q, 2)[::2])
+    monkeypatch.setattr(calling, '_SLOW_SAID', [])
+    with pytest.warns(SlowInputWarning, match=r'^q is a float32 array'):
+        mass_matrix(arm, q.astype(np.float32))
