@@ -195,7 +195,7 @@ def test_a_push_within_the_band_on_the_settled_arm(graph):
         g['js'].publish(msg)
         g['probe'].spin_for(0.01)
         sent.append(stamp)
-    for k in range(150):                            # 1.5 s at rest
+    for k in range(300):                            # 3 s at rest
         send(5000 + k, gravity + HELD)
     resting = len(sent)
     # the repeats of ~/contact while it rested (no pause: a gap in the
