@@ -20,6 +20,7 @@
                          [--topic T] [--gain K] [--thresholds T [T ...]]
                          [--speed-thresholds B [B ...]]
                          [--acceleration-thresholds C [C ...]]
+                         [--rest-thresholds T [T ...]]
                          [--static-friction R] [--no-rest-reference]
                          [--hysteresis H] [--damping L] [--max-gap S]
                          [--payload-mass M] [--payload-com X Y Z]
@@ -88,6 +89,11 @@ def register(subparsers):
                      default=[0.0], metavar='C', help='per joint (or one '
                      'for all), the threshold grows by C per rad/s^2 of '
                      "the joint's acceleration (N m s^2/rad; default 0)")
+    obs.add_argument('--rest-thresholds', type=float, nargs='+',
+                     default=[0.0], metavar='T', help='per joint (or one '
+                     "for all), the rest reference's own tolerance: its "
+                     'tests use the larger of this and the threshold '
+                     '(default 0: the threshold)')
     obs.add_argument('--static-friction', type=float, default=1.5,
                      metavar='R', help='at rest, allow for static friction '
                      "up to R x each joint's Coulomb friction (URDF "
@@ -166,7 +172,7 @@ def _setup(args):
         model = payload_model(model, args.payload_mass, args.payload_com,
                               [0.0] * 6)
         for name in ('thresholds', 'speed_thresholds',
-                     'acceleration_thresholds'):
+                     'acceleration_thresholds', 'rest_thresholds'):
             given = getattr(args, name)
             if len(given) not in (1, model.n):
                 raise ValueError(
@@ -179,12 +185,14 @@ def _setup(args):
                                speed_thresholds=args.speed_thresholds,
                                acceleration_thresholds=(
                                    args.acceleration_thresholds),
+                               rest_thresholds=args.rest_thresholds,
                                hysteresis=args.hysteresis,
                                rest_reference=args.rest_reference,
                                **drive_options(model, args.static_friction))
     except ValueError as exc:
         text = str(exc).replace('payload.', '--payload-')
-        for name in ('acceleration_thresholds', 'speed_thresholds'):
+        for name in ('acceleration_thresholds', 'speed_thresholds',
+                     'rest_thresholds'):
             text = text.replace(f'{name}:', f'--{name.replace("_", "-")}:')
         raise _Usage(text) from None
     return model, obs
@@ -299,10 +307,12 @@ def _summary(args, model, obs, rec, out):
     """Return what the command found, as a dict (the --json object)."""
     from .core.observer import beyond_friction, suggest_thresholds
     from .core.observer.thresholds import (rest_changes,
+                                           suggest_rest_thresholds,
                                            suggest_state_thresholds)
     t = out.t
     resting = (np.abs(rec.qd) < obs.friction_width).all(axis=1)
     constant = obs.torque_constant
+    state = suggest_state_thresholds(out)
     return {
         'robot': model.name, 'bag': args.bag, 'topic': args.topic,
         'joints': list(model.joint_names), 'samples': int(len(t)),
@@ -321,9 +331,12 @@ def _summary(args, model, obs, rec, out):
         'suggested_thresholds': suggest_thresholds(out).tolist(),
         'speed_thresholds': obs.speed_thresholds.tolist(),
         'acceleration_thresholds': obs.acceleration_thresholds.tolist(),
+        'rest_thresholds': obs.rest_thresholds.tolist(),
         'suggested_state_thresholds': dict(zip(
-            ('thresholds', 'speed_thresholds', 'acceleration_thresholds'),
-            (x.tolist() for x in suggest_state_thresholds(out)))),
+            ('thresholds', 'speed_thresholds', 'acceleration_thresholds',
+             'rest_thresholds'),
+            (x.tolist() for x in (*state, suggest_rest_thresholds(
+                out, *state))))),
         'contacts': int(out.contacts),
         'contact_fraction': float(out.contact.mean()),
         'resting_fraction': float(resting.mean()),
@@ -372,6 +385,8 @@ def _table(s):
                      f'{x:.3g}' for x in state['speed_thresholds'])
                  + ' --acceleration-thresholds ' + ' '.join(
                      f'{x:.3g}' for x in state['acceleration_thresholds'])
+                 + ' --rest-thresholds ' + ' '.join(
+                     f'{x:.3g}' for x in state['rest_thresholds'])
                  + ')')
     for note in s['notes']:
         lines.append(f'note: {note}')

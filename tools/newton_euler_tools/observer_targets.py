@@ -68,11 +68,12 @@ def recordings(seed, out_dir):
 
 
 def observed(urdf, path, thresholds, rest_reference=True, speed=0.0,
-             acceleration=0.0):
+             acceleration=0.0, rest=0.0):
     """
     Run the observer over a bag as ``observe`` does (in process).
 
-    ``speed``, ``acceleration``: its speed and acceleration thresholds.
+    ``speed``, ``acceleration``, ``rest``: its speed, acceleration and
+    rest thresholds.
     """
     from newton_euler_ros.core import load_robot
     from newton_euler_ros.core.observer import (drive_options,
@@ -87,7 +88,7 @@ def observed(urdf, path, thresholds, rest_reference=True, speed=0.0,
                            rest_reference=rest_reference,
                            speed_thresholds=speed,
                            acceleration_thresholds=acceleration,
-                           **drive_options(model))
+                           rest_thresholds=rest, **drive_options(model))
     return rec, observe_recording(obs, rec.stamps, rec.q, rec.qd,
                                   rec.effort)
 
@@ -217,18 +218,21 @@ def moving_evaluate(data, state=True):
     of their onset.
     """
     from newton_euler_ros.core.observer.thresholds import (
-        suggest_state_thresholds, suggest_thresholds)
+        suggest_rest_thresholds, suggest_state_thresholds, suggest_thresholds)
     _, out = observed(data['urdf'], data['runs']['free_1'][0], 10.0)
     if state:
         a, b, c = suggest_state_thresholds(out)
+        rest = suggest_rest_thresholds(out, a, b, c)
     else:
-        a, b, c = suggest_thresholds(out), 0.0, 0.0
-    got = {'thresholds': [np.asarray(x).tolist() for x in (a, b, c)]}
+        a, b, c, rest = suggest_thresholds(out), 0.0, 0.0, 0.0
+    got = {'thresholds': [np.asarray(x).tolist() for x in (a, b, c, rest)]}
     for name in ('validation', 'rest'):
-        _, o = observed(data['urdf'], data['runs'][name][0], a, True, b, c)
+        _, o = observed(data['urdf'], data['runs'][name][0], a, True, b, c,
+                        rest)
         got[name] = int(o.contacts)
         got[name + '_share'] = float(o.contact.mean())
-    rec, o = observed(data['urdf'], data['runs']['pushed'][0], a, True, b, c)
+    rec, o = observed(data['urdf'], data['runs']['pushed'][0], a, True, b, c,
+                      rest)
     rows, at_rest = pushes_felt(data, rec, o)
     got.update(rows=rows, at_rest=at_rest,
                felt={w: (sum(r[2] is not None for r in rows if r[1] == w),
@@ -262,7 +266,7 @@ def moving_main(seeds, out):
                       f'{e["felt"]["rest"][1]:<3}{e["felt"]["move"][0]:>3} '
                       f'of {e["felt"]["move"][1]:<3}{e["soon"]:>6} of 10')
                 if state:
-                    print('      (a, b, c) = ' + '; '.join(
+                    print('      (a, b, c; rest) = ' + '; '.join(
                         ' '.join(f'{v:.2g}' for v in x)
                         for x in e['thresholds']))
     for kind, t in total.items():

@@ -130,6 +130,8 @@ class NodeObserver:
             acceleration_thresholds=_per_joint(
                 'observer.acceleration_thresholds',
                 p['observer.acceleration_thresholds'], model),
+            rest_thresholds=_per_joint('observer.rest_thresholds',
+                                       p['observer.rest_thresholds'], model),
             hysteresis=_at_most_one(p['observer.hysteresis']),
             rest_reference=p['observer.rest_reference'], **options)
         if obs.torque_constant is not None and 'constants' not in self.said:

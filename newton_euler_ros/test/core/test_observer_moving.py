@@ -163,6 +163,7 @@ def test_the_lagged_speed_bounds_a_residual_of_an_error_in_speed():
     ({'acceleration_thresholds': float('nan')},
      'acceleration_thresholds: must be finite'),
     ({'speed_thresholds': [1.0, 2.0]}, 'speed_thresholds: must have 1 or 7'),
+    ({'rest_thresholds': -0.5}, 'rest_thresholds: must be finite'),
 ])
 def test_bad_parameters_are_one_line_errors(kw, says):
     with pytest.raises(ValueError) as err:
@@ -175,6 +176,7 @@ def test_bad_parameters_are_one_line_errors(kw, says):
     (['--acceleration-thresholds', 'nan'],
      '--acceleration-thresholds: must be finite'),
     (['--speed-thresholds', '1', '2'], '--speed-thresholds: give 1 or 6'),
+    (['--rest-thresholds', '-1'], '--rest-thresholds: must be finite'),
 ])
 def test_observe_says_bad_thresholds_in_one_line(arm, args, says):
     cmd = [os.path.join(ROOT, '.venv', 'bin', 'newton-euler'), 'observe',
@@ -184,3 +186,76 @@ def test_observe_says_bad_thresholds_in_one_line(arm, args, says):
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and says in lines[0], done.stderr
+
+
+def test_rest_thresholds_arm_the_rest_reference_where_a_is_small(tmp_path):
+    """
+    An arm whose fitted intercepts are small (seed 13).
+
+    0.24 N m on its shoulder lift.
+    With ``a`` alone the rest reference's tests are as tight as ``a``:
+    it arms late or never, and when it does the held poses' drifting
+    friction is reported as contact; pushes on the resting arm go
+    unreported.  With the suggested rest thresholds: no episode on the
+    held poses or the held-out motion, every push on the resting arm
+    reported.
+    """
+    from newton_euler_ros.core.observer.thresholds import (
+        suggest_rest_thresholds)
+    from newton_euler_tools import observer_targets as targets
+    data = targets.moving_recordings(13, str(tmp_path))
+    _, out = targets.observed(data['urdf'], data['runs']['free_1'][0], 10.0)
+    a, b, c = suggest_state_thresholds(out)
+    rest = suggest_rest_thresholds(out, a, b, c)
+    assert (rest > 4.0 * a).any() and (rest >= a).all(), (a, rest)
+    _, held = targets.observed(data['urdf'], data['runs']['rest'][0], a,
+                               True, b, c)
+    assert held.contacts > 0            # without them
+    got = targets.moving_evaluate(data)
+    assert got['rest'] == 0 and got['validation'] == 0, got
+    felt, count = got['felt']['rest']
+    assert felt == count > 0, got['rows']
+    assert got['soon'] >= 9, got['rows']
+
+
+def test_observe_suggests_the_four_lists_and_takes_them_back(arm, fitted):
+    """
+    ``observe --json`` suggests a, b, c and the rest thresholds.
+
+    The library's suggestions, printed on the table's last line; given
+    back, they are what runs.
+    """
+    import json
+    from cli_harness import newton_euler
+    from newton_euler_ros.core.observer.thresholds import (
+        suggest_rest_thresholds)
+    fit = os.path.join(arm['dir'], 'fit')
+    common = [arm['urdf'], fit, '--base', 'base_link', '--tip', 'tool0',
+              '--thresholds', '10']
+    status, out, err = newton_euler('observe', *common, '--json')
+    assert status == 0, err
+    state = json.loads(out)['suggested_state_thresholds']
+    free = _observe(arm, 'fit', thresholds=10.0)
+    a, b, c = fitted
+    assert state['thresholds'] == a.tolist()
+    assert state['speed_thresholds'] == b.tolist()
+    assert state['acceleration_thresholds'] == c.tolist()
+    assert state['rest_thresholds'] == suggest_rest_thresholds(
+        free, a, b, c).tolist()
+    status, text, err = newton_euler('observe', *common)
+    assert status == 0, err
+    line = next(x for x in text.splitlines() if '--rest-thresholds' in x)
+    assert ' '.join(f'{x:.3g}' for x in state['rest_thresholds']) in line
+    # given back: the JSON says what ran
+    given = [arm['urdf'], os.path.join(arm['dir'], 'held_out'), '--base',
+             'base_link', '--tip', 'tool0', '--json']
+    for key, opt in (('thresholds', '--thresholds'),
+                     ('speed_thresholds', '--speed-thresholds'),
+                     ('acceleration_thresholds', '--acceleration-thresholds'),
+                     ('rest_thresholds', '--rest-thresholds')):
+        given += [opt] + [repr(x) for x in state[key]]
+    status, out, err = newton_euler('observe', *given)
+    assert status == 0, err
+    ran = json.loads(out)
+    assert ran['rest_thresholds'] == state['rest_thresholds']
+    assert ran['contacts'] == 0

@@ -262,13 +262,17 @@ class ContactState:
     # the lagged speeds and accelerations (``motion.py``)
     motion: MotionState = None
     threshold: np.ndarray = None    # per joint, the last sample's
+    # per joint, the rest reference's: the larger of that and
+    # the observer's rest_thresholds
+    rest_threshold: np.ndarray = None
 
 
 def initial_contact(obs):
     """Return a contact state with no joint in contact."""
     return ContactState(np.zeros(obs.n, dtype=np.bool_),
                         rest=RestState(obs.n), motion=MotionState(obs.n),
-                        threshold=obs.thresholds.copy())
+                        threshold=obs.thresholds.copy(),
+                        rest_threshold=obs.thresholds.copy())
 
 
 def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
@@ -279,7 +283,8 @@ def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
     (``state.allowance``), added to every threshold; None: none.  With
     the sample's stamp ``t`` (s), ``q`` and ``qd`` (model order), and the
     observer's ``rest_reference`` on, a joint is also in contact by the
-    rest reference's test (``contact.py``).  With ``t`` and
+    rest reference's test (``contact.py``), with the larger of each
+    threshold and the observer's ``rest_thresholds``.  With ``t`` and
     ``qd``, each threshold grows with the joint's speed and acceleration
     by the observer's ``speed_thresholds`` and
     ``acceleration_thresholds`` (``motion.py``; the thresholds
@@ -294,7 +299,12 @@ def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
             thr = state_thresholds(obs, contact.motion, contact.threshold)
     now = _contact(r, thr, obs.hysteresis, allowance, contact.active)
     if t is not None and obs.rest_reference and contact.rest is not None:
-        now |= rest_step(contact.rest, t, q, qd, r, thr, obs.hysteresis,
+        rest_thr = thr
+        if contact.rest_threshold is not None and \
+                obs.rest_thresholds.any():
+            rest_thr = np.maximum(thr, obs.rest_thresholds,
+                                  out=contact.rest_threshold)
+        now |= rest_step(contact.rest, t, q, qd, r, rest_thr, obs.hysteresis,
                          obs.max_gap, contact.active)
     if now and not contact.in_contact:
         contact.count += 1

@@ -238,6 +238,12 @@ class MomentumObserver:
     rest_reference : also test, once the whole arm rests, each residual's
         change from the value it settled to (``contact.py``): a
         push on a resting arm is felt within the friction band.
+    rest_thresholds : per joint (>= 0), the rest reference's own
+        tolerance: its calm test and its test of the change use the
+        larger of it and the threshold; 0: the threshold alone.  With
+        thresholds that grow with speed, whose ``a`` can be near 0
+        where the static friction allowance covers a resting joint
+        (``thresholds.suggest_rest_thresholds``).
     ws : a :class:`Workspace` of the model (a new one by default); not
         shared with another thread.
 
@@ -248,7 +254,7 @@ class MomentumObserver:
                  hysteresis=0.5, torque_constant=None, static_friction=None,
                  friction_width=DEFAULT_COULOMB_WIDTH, rest_reference=True,
                  speed_thresholds=0.0, acceleration_thresholds=0.0,
-                 ws=None):
+                 rest_thresholds=0.0, ws=None):
         n = model.n
         self.model = model
         self.n = n
@@ -290,6 +296,8 @@ class MomentumObserver:
                                            speed_thresholds, n, False)
         self.acceleration_thresholds = _per_joint(
             'acceleration_thresholds', acceleration_thresholds, n, False)
+        self.rest_thresholds = _per_joint('rest_thresholds', rest_thresholds,
+                                          n, False)
         self.hysteresis = float(hysteresis)
         if not (0.0 < self.hysteresis <= 1.0):
             raise ValueError(f'hysteresis: must be in (0, 1], got '

@@ -31,6 +31,11 @@ from .contact import rest_deviations
 #: the peaks of other recordings of like motion reached up to 1.6 x that
 #: of the one suggesting (model error depends on the motion)
 FACTOR = 2.0
+#: the rest reference's own tolerance = this x FACTOR x the largest
+#: change of a settled residual on the free recording (held poses rest
+#: longer than its stops): measured over 18 arms of the current-sensing
+#: example (docs/observer.md)
+REST_MARGIN = 2.0
 
 
 def beyond_friction(recording):
@@ -89,6 +94,35 @@ def suggest_state_thresholds(recording, factor=FACTOR):
         a = np.maximum(a, [_round_up(factor * x) if x > 0.0 else 0.0
                            for x in rest])
     return a, b, c
+
+
+def suggest_rest_thresholds(recording, a, b, c, factor=FACTOR,
+                            margin=REST_MARGIN):
+    """
+    Return per joint the rest reference's own tolerance (n,).
+
+    With thresholds ``a + b s + c u`` (:func:`suggest_state_thresholds`)
+    a joint's ``a`` can be near 0, the static friction allowance
+    covering it at rest; the rest reference's calm test (the settled
+    residual within the threshold) then never passes and it never arms,
+    on the free recording or after.  Its own tolerance: ``margin`` x
+    ``factor`` x the largest change from the rest value on the free
+    recording, the rest reference run first with one threshold per
+    joint (which arms it), then twice with these tolerances; never below
+    ``a``.  The margin: a held pose rests longer than the recording's
+    stops, and the friction it holds drifts further.
+    """
+    thr = a + b * recording.speed + c * recording.acceleration
+    rest = _rounded(factor, rest_changes(recording, factor))
+    for _ in range(2):
+        changes = rest_changes(recording, factor, np.maximum(thr, rest))
+        rest = np.maximum(a, _rounded(margin * factor, changes))
+    return rest
+
+
+def _rounded(factor, changes):
+    return np.array([_round_up(factor * x) if x > 0.0 else 0.0
+                     for x in changes])
 
 
 def _envelope(y, s, u):
