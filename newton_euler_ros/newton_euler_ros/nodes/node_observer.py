@@ -419,12 +419,14 @@ def contact_text(obs, contact, r, allowance):
     observer has speed or acceleration thresholds); ``+ 0.5 static
     friction`` where
     the joint's static friction allowance raises the bound; a joint
-    found by the rest reference alone by its change from its rest value.
+    found by the rest reference alone by its change from its rest value,
+    with the rest reference's threshold (at least its rest threshold).
     """
     units = joint_units(obs.model)
     # the threshold in effect: grown with speed and acceleration if set
     thresholds = (contact.threshold if obs.moving_thresholds and
                   contact.threshold is not None else obs.thresholds)
+    rest_thresholds = np.maximum(thresholds, obs.rest_thresholds)
     rest = contact.rest
     by_rest = (rest.active if rest is not None and obs.rest_reference
                else np.zeros(obs.n, dtype=bool))
@@ -439,7 +441,7 @@ def contact_text(obs, contact, r, allowance):
         elif by_rest[j]:
             parts.append(f'{name} {r[j]:.3g} {unit}, '
                          f'{rest.deviation[j]:.3g} from its rest value '
-                         f'(threshold {thr:.3g})')
+                         f'(threshold {rest_thresholds[j]:.3g})')
     return ', '.join(parts)
 
 

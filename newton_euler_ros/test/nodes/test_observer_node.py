@@ -279,3 +279,37 @@ def test_the_contact_line_gives_the_threshold_in_effect(puma):
     text = contact_text(obs, contact, r, None)
     assert f'joint2 20 N m (threshold {grown:.3g})' in text, text
     assert 'threshold 2)' not in text
+
+
+def test_a_rest_contact_line_gives_the_rest_threshold(puma):
+    """Found by the rest reference: its threshold, the rest threshold."""
+    from newton_euler_ros.core.observer import (contact_step,
+                                                initial_contact,
+                                                MomentumObserver)
+    from newton_euler_ros.nodes.node_observer import contact_text
+    obs = MomentumObserver(puma, thresholds=0.5, rest_thresholds=[
+        0.0, 3.0, 0.0, 0.0, 0.0, 0.0], static_friction=20.0)
+    contact = initial_contact(obs)
+    zero = np.zeros(6)
+    r = zero.copy()
+    allowance = np.full(6, 20.0)    # the band test feels nothing
+    t = 0.0
+    for k in range(600):            # 0.6 s settled: the rest value is 0
+        t = 1e-3 * k
+        contact_step(obs, contact, r, allowance, t, Q, zero)
+    assert contact.rest.armed
+    r[1] = 2.5                      # within the rest threshold: nothing
+    for k in range(200):
+        t += 1e-3
+        assert not contact_step(obs, contact, r, allowance, t, Q, zero)
+    r[1] = 4.0                      # beyond it, for 80 ms: contact
+    for k in range(100):
+        t += 1e-3
+        now = contact_step(obs, contact, r, allowance, t, Q, zero)
+    assert now and contact.rest.active[1] and not contact.active[1]
+    text = contact_text(obs, contact, r, allowance)
+    # (the rest value followed the 2.5 N m's drift a little, 2 s lag)
+    dev = float(contact.rest.deviation[1])
+    assert 3.0 < dev < 4.0
+    assert text == (f'joint2 4 N m, {dev:.3g} from its rest value '
+                    '(threshold 3)'), text
