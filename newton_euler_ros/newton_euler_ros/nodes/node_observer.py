@@ -84,7 +84,8 @@ class NodeObserver:
             try:
                 self.observer_for(ff)
             except ValueError as exc:
-                raise ConfigurationError(str(exc)) from None
+                raise ConfigurationError(_parameter_named(str(exc))) \
+                    from None
 
     def warm_kernels(self, ff):
         """
@@ -463,6 +464,18 @@ def _units_text(units):
     unit = 'N m per torque_constant' if units.mode == 'given' else 'N m'
     plural = 's' if units.windows != 1 else ''
     return f'{unit} (checked on {units.windows} window{plural} of motion)'
+
+
+#: the observer's settings that are node parameters of the same name
+_OBSERVER_PARAMETERS = ('gain', 'max_gap', 'damping', 'thresholds',
+                        'speed_thresholds', 'acceleration_thresholds',
+                        'rest_thresholds', 'hysteresis')
+
+
+def _parameter_named(text):
+    """Name the node parameter (observer.X) in the library's error on X."""
+    name = text.split(':', 1)[0]
+    return f'observer.{text}' if name in _OBSERVER_PARAMETERS else text
 
 
 def _per_joint(name, values, model):

@@ -250,6 +250,10 @@ def test_the_payload_is_not_external(graph, puma):
      'observer.thresholds: must have 1 or 6 values'),
     (['-p', 'observer.hysteresis:=1.5'], 'observer.hysteresis: must be <= 1'),
     (['-p', 'observer.gain:=0.0'], 'observer.gain: must be > 0'),
+    (['-p', 'observer.rest_thresholds:=[-3.0]'],
+     'observer.rest_thresholds: must be finite and >= 0'),
+    (['-p', 'observer.speed_thresholds:=[-1.0]'],
+     'observer.speed_thresholds: must be finite and >= 0'),
 ])
 def test_bad_observer_settings_refuse_to_start(args, message):
     cmd = id_node_cmd('puma560.yaml', '-p', 'observer.enabled:=true', *args)
