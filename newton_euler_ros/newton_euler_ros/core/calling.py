@@ -78,6 +78,9 @@ BOOL = types.boolean
 
 
 _F64 = F64 = np.dtype(np.float64)   # compared by identity first: cheaper
+# the fast paths' test of an input's type: a name of this module is
+# found in about 8 ns, np.ndarray in about 21 (two lookups)
+ARRAY = np.ndarray
 
 
 class StrictEntry:
@@ -154,7 +157,7 @@ def slow_inputs(values, names=INPUTS, stacklevel=3):
     if _SLOW_SAID:
         return
     for name, x in zip(names, values):
-        if type(x) is np.ndarray:
+        if type(x) is ARRAY:
             if x.dtype != _F64:
                 what = f'a {x.dtype} array'
             elif not x.flags.writeable:
@@ -206,7 +209,7 @@ def foreign_workspace(model, ws):
 
 def vector(name, x, size):
     """Return x as a contiguous float64 vector of the given size, or raise."""
-    if (type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1
+    if (type(x) is ARRAY and x.dtype == np.float64 and x.ndim == 1
             and x.flags.c_contiguous and x.flags.writeable):
         arr = x
     else:

@@ -49,7 +49,7 @@ import numpy as np
 
 from . import kernels as K
 from .batch import run_split
-from .calling import (F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
+from .calling import (ARRAY, F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
                       INT, MAT, matrix, out_array, PACKED, slow_inputs,
                       status_error, strict_entry, VEC, vector, workspace,
                       wrench_mode)
@@ -118,7 +118,7 @@ def inverse_dynamics_derivatives(model, q, qd=None, qdd=None, wrench=None,
     """
     w = model.default_workspace if ws is None else ws
     flags = _flags(gravity, wrench, wrench_frame)
-    if (type(wrench) is not dict and type(q) is np.ndarray
+    if (type(wrench) is not dict and type(q) is ARRAY
             and q.dtype is F64):    # lists, float32, link wrenches: below
         try:
             n = w.n
@@ -161,7 +161,7 @@ def forward_dynamics_derivatives(model, q, qd, tau, wrench=None,
     w = model.default_workspace if ws is None else ws
     flags = _flags(gravity, wrench, wrench_frame)
     if (drives is None and type(wrench) is not dict
-            and type(q) is np.ndarray and q.dtype is F64):
+            and type(q) is ARRAY and q.dtype is F64):
         try:
             n = w.n
             res = np.empty((3, n, n)) if out is None else out

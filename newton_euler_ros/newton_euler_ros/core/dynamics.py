@@ -77,8 +77,8 @@ from . import kernels as K
 from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
                     gravity_torques_batch, inverse_dynamics_batch,
                     mass_matrix_batch)
-from .calling import (bad_method, BOOL, CORIOLIS_METHODS, F64, FD_INPUTS,
-                      first_singular_pivot, foreign_workspace,
+from .calling import (ARRAY, bad_method, BOOL, CORIOLIS_METHODS, F64,
+                      FD_INPUTS, first_singular_pivot, foreign_workspace,
                       FORWARD_DYNAMICS_METHODS, INPUTS, inputs, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
                       out_array, PACKED, slow_inputs, status_error,
@@ -173,8 +173,8 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
             return _tau_at_links(model, ws, q, qd, qdd, wrench, wrench_frame,
                                  flags, out)
         flags |= wrench_mode(wrench, wrench_frame) << 2
-    if type(q) is not np.ndarray or q.dtype is not F64 or (
-            wrench is not None and type(wrench) is not np.ndarray):
+    if type(q) is not ARRAY or q.dtype is not F64 or (
+            wrench is not None and type(wrench) is not ARRAY):
         # lists, int arrays: converted at once, not tried first
         return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
     try:
@@ -253,7 +253,7 @@ def _tau_at_links(model, ws, q, qd, qdd, wrenches, wrench_frame, flags,
 def gravity_torques(model, q, *, ws=None, out=None):
     """g(q): the joint torques that hold the arm still against gravity."""
     w = model.default_workspace if ws is None else ws
-    if type(q) is not np.ndarray or q.dtype is not F64:
+    if type(q) is not ARRAY or q.dtype is not F64:
         # a list, an int array: converted at once, not tried first
         ws = workspace(model, ws)
         q = inputs(ws, INPUTS, q)[0]
@@ -290,7 +290,7 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
     times them).  Any other ``method`` raises ValueError.
     """
     if method == 'crba':
-        if type(q) is np.ndarray:   # lists: below
+        if type(q) is ARRAY:   # lists: below
             w = model.default_workspace if ws is None else ws
             try:
                 D = np.empty(w.square) if out is None else out
@@ -344,7 +344,7 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
         composite = False
     else:
         raise bad_method(method, CORIOLIS_METHODS)
-    if type(q) is np.ndarray:   # lists: below
+    if type(q) is ARRAY:   # lists: below
         w = model.default_workspace if ws is None else ws
         try:
             C = np.empty(w.square) if out is None else out
@@ -394,8 +394,8 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
         method = 'cholesky'
     if method == 'aba':
         w = model.default_workspace if ws is None else ws
-        if type(q) is not np.ndarray or q.dtype is not F64 or (
-                wrench is not None and type(wrench) is not np.ndarray):
+        if type(q) is not ARRAY or q.dtype is not F64 or (
+                wrench is not None and type(wrench) is not ARRAY):
             # lists, int arrays: converted at once, not tried first
             return _aba_converted(model, ws, q, qd, tau, wrench,
                                   wrench_frame, flags, out)

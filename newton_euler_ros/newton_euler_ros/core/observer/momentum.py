@@ -80,7 +80,7 @@ import numpy as np
 
 from .contact import contact_step, initial_contact
 from .wrench import external_wrench
-from ..calling import (F64, F8, MAT, PACKED, slow_inputs,
+from ..calling import (ARRAY, F64, F8, MAT, PACKED, slow_inputs,
                        status_error, strict_entry, VEC, vector, workspace)
 from ..drives import DEFAULT_COULOMB_WIDTH
 from ..errors import DynamicsInputError
@@ -451,8 +451,8 @@ def observer_step(obs, state, t, q, qd, tau):
         qd = _vector('qd', qd, obs.n)
         lost = _vector('drive_torque', obs.drive_torque(qd, None), obs.n)
     code = None
-    if (type(q) is np.ndarray and q.dtype is F64 and type(qd) is np.ndarray
-            and type(tau) is np.ndarray):   # lists: converted below
+    if (type(q) is ARRAY and q.dtype is F64 and type(qd) is ARRAY
+            and type(tau) is ARRAY):   # lists: converted below
         try:
             code = _step_strict(obs._packed, q, qd, tau, lost, dt,
                                 obs.ws.ws, obs.ws.cw, obs._buf, state.S,

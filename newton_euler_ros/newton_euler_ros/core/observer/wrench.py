@@ -34,7 +34,7 @@ import math
 from numba import njit
 import numpy as np
 
-from ..calling import (BOOL, F64, F8, INT, MAT, out_array, PACKED,
+from ..calling import (ARRAY, BOOL, F64, F8, INT, MAT, out_array, PACKED,
                        slow_inputs, status_error, strict_entry, TARGET, VEC,
                        vector)
 from ..dynamics import jacobian
@@ -177,8 +177,8 @@ def _solved(entry, obs, q, r, out, *frame):
     between the damping and the workspace; none for the end effector.
     """
     code = None
-    if (type(q) is np.ndarray and q.dtype is F64
-            and type(r) is np.ndarray):     # lists: converted below
+    if (type(q) is ARRAY and q.dtype is F64
+            and type(r) is ARRAY):     # lists: converted below
         F = np.empty(6) if out is None else out
         try:
             code = entry(obs._packed, q, r, obs.damping, *frame, obs.ws.ws,
