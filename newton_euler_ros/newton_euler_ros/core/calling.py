@@ -117,6 +117,7 @@ class StrictEntry:
         """Compile (or load from the cache) the one signature; return it."""
         with self._lock:
             if self.dispatcher is None:
+                K.package_locators()    # numba reads them here
                 dispatcher = njit(**K.ENTRY)(self.kernel.py_func)
                 dispatcher.compile(self.signature)
                 dispatcher.disable_compile()

@@ -69,6 +69,8 @@ from numba import njit
 import numpy as np
 
 from ..core.errors import DynamicsInputError
+# the package's cache locators stand first before njit(cache=True) below
+from ..core.kernels import package_locators  # noqa: F401
 
 MARGIN = 0.05
 DEFAULT_VELOCITY = 1.0       # rad/s (m/s for prismatic: DEFAULT_VELOCITY_P)

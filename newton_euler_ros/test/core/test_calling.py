@@ -19,14 +19,16 @@ A strict entry is compiled for one signature on its first call and then
 closed to others, so numba answers any other argument type with its
 ``TypeError`` and never compiles a variant.  It uses only numba's public
 dispatcher API.  The package's source names none of numba's private
-dispatcher or cache members but one: the content stamps of the kernel
-cache (``core/kernels/_jit.py``), for which numba has no public hook
-(without it a fresh clone would recompile every kernel, numba stamping a
-cached function by its file's modification time); a numba without it
-falls back to numba's own stamps, and a test here says so.
+dispatcher or cache members: the kernel cache's locators
+(``core/kernels/_jit.py``) are put first in numba's documented setting
+for its locator list, and every other function keeps numba's own.
 """
 import ast
+import importlib
+import os
 import pathlib
+import subprocess
+import sys
 import threading
 import warnings
 
@@ -42,8 +44,8 @@ import numpy as np
 import pytest
 
 PACKAGE = pathlib.Path(calling.__file__).resolve().parents[1]
-# (file, name): the one private use, with the reason above
-ALLOWED = {('core/kernels/_jit.py', '_locator_classes')}
+# (file, name): private uses allowed (none)
+ALLOWED = set()
 
 
 def _private_numba_names():
@@ -80,14 +82,70 @@ def test_the_package_uses_no_private_numba_name():
     assert not found, f'numba private names used: {found}'
 
 
-def test_numba_still_has_the_cache_hook_the_kernel_stamps_use():
-    impl = getattr(caching, 'CacheImpl', None) or getattr(
-        caching, '_CacheImpl', None)
-    classes = getattr(impl, '_locator_classes', None)
-    assert classes is not None, (
-        'numba.core.caching has no _locator_classes: core/kernels/_jit.py '
-        "falls back to numba's own stamps (a fresh clone recompiles)")
-    assert any(c.__name__.startswith('KernelPackage') for c in classes)
+def test_the_package_locators_stand_first_in_numbas_locator_setting():
+    from numba.core import config
+    ours = ['newton_euler_ros.core.kernels._jit.KernelPackage' + name
+            for name in ('UserProvidedCacheLocator', 'InTreeCacheLocator',
+                         'UserWideCacheLocator')]
+    saved = config.CACHE_LOCATOR_CLASSES
+    try:
+        assert saved.split(',')[:3] == ours
+        for path in ours:       # numba imports each by this name
+            module, name = path.rsplit('.', 1)
+            cls = getattr(importlib.import_module(module), name)
+            assert issubclass(cls, getattr(caching, name[13:]))
+        # numba sets the list back from the environment when a NUMBA_
+        # variable changes: the package puts its own first again, before
+        # numba's default list or before the user's
+        config.CACHE_LOCATOR_CLASSES = ''
+        assert K.package_locators()
+        assert config.CACHE_LOCATOR_CLASSES.split(',') == ours + [
+            'UserProvidedCacheLocator', 'InTreeCacheLocator',
+            'UserWideCacheLocator', 'IPythonCacheLocator', 'ZipCacheLocator']
+        config.CACHE_LOCATOR_CLASSES = 'InTreeCacheLocator'
+        K.package_locators()
+        assert config.CACHE_LOCATOR_CLASSES.split(',') == ours + [
+            'InTreeCacheLocator']
+        K.package_locators()        # once is enough
+        assert config.CACHE_LOCATOR_CLASSES.split(',') == ours + [
+            'InTreeCacheLocator']
+    finally:
+        config.CACHE_LOCATOR_CLASSES = saved
+
+
+USER_MODULE = """
+from numba import njit
+
+
+@njit(cache=True)
+def plus_one(x):
+    return x + 1
+"""
+
+
+def test_a_users_cached_function_keeps_numbas_own_cache_place(tmp_path):
+    folder = tmp_path / 'user_code'
+    folder.mkdir()
+    (folder / 'user_kernels.py').write_text(USER_MODULE)
+    cache = tmp_path / 'cache'
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(cache),
+               PYTHONPATH=os.pathsep.join(
+                   [str(folder), os.environ.get('PYTHONPATH', '')]))
+    code = ('import newton_euler_ros.core.kernels; import user_kernels; '
+            'assert user_kernels.plus_one(1) == 2')
+    proc = subprocess.run([sys.executable, '-W', 'ignore', '-c', code],
+                          env=env, cwd=str(tmp_path), capture_output=True,
+                          text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    place = caching.UserProvidedCacheLocator.get_suitable_cache_subpath(
+        str(folder / 'user_kernels.py'))
+    assert any(p.name.startswith('user_kernels.plus_one')
+               for p in (cache / place).iterdir()), sorted(
+        p.name for p in cache.iterdir())
+    # and the package's functions have the package's places (made as
+    # they are decorated: nothing of the package compiled here)
+    assert any(p.name.startswith('newton_euler_ros.core.kernels-')
+               for p in cache.iterdir())
 
 
 def _gravity_entry(home=None):

@@ -75,7 +75,7 @@ import types
 
 from . import entries as _entries
 from . import entries_derivatives as _entries_derivatives
-from ._jit import ENTRY
+from ._jit import ENTRY, package_locators
 from .aba import articulated_body
 from .cholesky import cholesky_solve
 from .coriolis import coriolis_matrix_composite
@@ -113,7 +113,8 @@ __all__ = [
     'L_COM', 'L_INERTIA', 'L_LEAD', 'L_MASS', 'L_MULT', 'L_OFFSET', 'L_P',
     'L_PARENT', 'L_R', 'L_STORE', 'L_TYPE', 'L_WIDTH', 'LINK_WRENCHES',
     'mass_matrix_columns', 'mass_matrix_crba', 'MIMIC', 'momentum_terms',
-    'NONFINITE', 'OVERFLOW', 'pack', 'recursion', 'round_into', 'SINGULAR',
+    'NONFINITE', 'OVERFLOW', 'pack', 'package_locators', 'recursion',
+    'round_into', 'SINGULAR',
     'SIZE', 'T_BRANCHED', 'T_NQ', 'T_TOOL', 'unit_columns', 'VELOCITY',
     'W_ACC', 'W_CT', 'W_DD', 'W_F', 'W_N', 'W_P', 'W_R', 'W_ST', 'W_WIDTH',
     'W_X', 'WRENCH_BASE', 'WRENCH_BITS', 'WRENCH_EE', 'WRENCH_NONE',

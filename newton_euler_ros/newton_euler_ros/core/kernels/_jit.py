@@ -26,7 +26,7 @@ Caching.  Numba's on-disk cache (``cache=True``) stamps each function with
 its own source file only, and an entry point carries compiled copies of
 the helpers it calls from the other kernel files; so every kernel
 function here is stamped with all the kernel files at once
-(``_PackageStamp``): editing any of them recompiles every entry point.
+(:func:`package_stamp`): editing any of them recompiles every entry point.
 A compiled module outside the package that calls kernel functions (the
 momentum observer) registers its file with :func:`uses_kernels` before
 its functions are decorated: its functions are then stamped with its own
@@ -41,7 +41,10 @@ default), and by the digest of the sources it is stamped with
 compilations of the last one (``make`` keeps them in the user's cache);
 an edited file recompiles only what it stamps, in a directory of its own;
 kernel caches of older sources are removed after a day, the four newest
-kept.
+kept.  The package's locators (numba's own kinds, taking only the
+package's files) are put first in numba's documented setting for its
+locator list, ``NUMBA_CACHE_LOCATOR_CLASSES`` (:func:`package_locators`):
+no private numba name is used.
 """
 import hashlib
 import os
@@ -136,48 +139,89 @@ def _prune(cache_dir, current, keep=4, min_age=86400.0):
             shutil.rmtree(os.path.join(cache_dir, name), ignore_errors=True)
 
 
+# numba's locators the package's stand before (the first that takes a
+# file places its functions); a user's NUMBA_CACHE_LOCATOR_CLASSES stands
+# after them instead, and otherwise numba's default list does (as numba
+# 0.68 orders it)
+_BASES = ('UserProvidedCacheLocator', 'InTreeCacheLocator',
+          'UserWideCacheLocator')
+_DEFAULTS = _BASES + ('IPythonCacheLocator', 'ZipCacheLocator')
+_LOCATORS = []      # the package's locator classes, made once
+_STAMP = [None]
+
+
+def _stamped(base):
+    """Return a locator of ``base``'s kind for the package's files only."""
+
+    class Locator(base):
+        def __init__(self, py_func, py_file):
+            super().__init__(py_func, py_file)
+            self.source_file = os.path.abspath(py_file)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if cache_subpath(py_file, _STAMP[0]) is None:
+                return None         # not ours: numba's own locators
+            return super().from_function(py_func, py_file)
+
+        @classmethod
+        def get_suitable_cache_subpath(cls, py_file):
+            return cache_subpath(py_file, _STAMP[0])
+
+        def get_source_stamp(self):
+            own = super().get_source_stamp()    # this function's file
+            path = self.source_file
+            if os.path.dirname(path) != _DIR and path not in _USERS:
+                return own
+            return (_STAMP[0], own)
+
+    Locator.__name__ = Locator.__qualname__ = f'KernelPackage{base.__name__}'
+    return Locator
+
+
+def package_locators():
+    """
+    Put the package's cache locators first in numba's configuration.
+
+    Through numba's own setting, ``numba.core.config.CACHE_LOCATOR_CLASSES``
+    (the ``NUMBA_CACHE_LOCATOR_CLASSES`` variable): a comma-separated
+    list of locator classes, each named by its module path, the first
+    that takes a function's file placing it.  The package's take only
+    its own files, so every other function keeps numba's locators (the
+    user's list, or numba's default one, after ours).  numba reads the
+    setting when a function is decorated with ``cache=True``: called on
+    import and again before each entry compiles (``core.calling``), since
+    numba sets it back from the environment when a ``NUMBA_`` variable
+    changes.  A numba without the setting keeps its own stamps (a fresh
+    clone then recompiles).  Returns whether the setting is there.
+    """
+    from numba.core import config
+    current = getattr(config, 'CACHE_LOCATOR_CLASSES', None)
+    if current is None or _COPY:
+        return False
+    if not _LOCATORS:
+        from numba.core import caching
+        for name in _BASES:
+            cls = _stamped(getattr(caching, name))
+            globals()[cls.__name__] = cls   # numba imports it by this name
+            _LOCATORS.append(cls)
+    ours = [f'{__name__}.{cls.__name__}' for cls in _LOCATORS]
+    names = [n.strip() for n in current.split(',') if n.strip()]
+    if names[:len(ours)] != ours:
+        rest = [n for n in names if n not in ours] or list(_DEFAULTS)
+        config.CACHE_LOCATOR_CLASSES = ','.join(ours + rest)
+    return True
+
+
 def _install_package_stamp():
     """Stamp and place the package's cached functions (see above)."""
-    from numba.core import caching
-
-    stamp = package_stamp()
-
-    def stamped(base):
-        class Locator(base):
-            @classmethod
-            def from_function(cls, py_func, py_file):
-                if cache_subpath(py_file, stamp) is None:
-                    return None         # not ours: numba's own locators
-                return super().from_function(py_func, py_file)
-
-            @classmethod
-            def get_suitable_cache_subpath(cls, py_file):
-                return cache_subpath(py_file, stamp)
-
-            def get_source_stamp(self):
-                own = super().get_source_stamp()    # this function's file
-                path = os.path.abspath(self._py_file)
-                if os.path.dirname(path) != _DIR and path not in _USERS:
-                    return own
-                return (stamp, own)
-
-        Locator.__name__ = f'KernelPackage{base.__name__}'
-        return Locator
-
-    impl = getattr(caching, 'CacheImpl', None) or getattr(
-        caching, '_CacheImpl', None)
-    classes = getattr(impl, '_locator_classes', None)
-    if classes is None:     # another numba: per-file stamps, as numba has
+    _STAMP[0] = package_stamp()
+    if not package_locators():
         return
-    if not any(c.__name__.startswith('KernelPackage') for c in classes):
-        bases = [caching.UserProvidedCacheLocator,
-                 caching.InTreeCacheLocator,
-                 caching.UserWideCacheLocator]
-        classes[:0] = [stamped(b) for b in bases]
     from numba.core import config
     if config.CACHE_DIR:
         _prune(config.CACHE_DIR, cache_subpath(os.path.join(_DIR, '_jit.py'),
-                                               stamp))
+                                               _STAMP[0]))
 
 
 if not _COPY:
