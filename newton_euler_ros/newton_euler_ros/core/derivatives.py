@@ -49,7 +49,7 @@ import numpy as np
 
 from . import kernels as K
 from .batch import run_split
-from .calling import (ARRAY, F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
+from .calling import (ARRAY, EMPTY, F64, FD_INPUTS, foreign_workspace, INPUTS, inputs,
                       INT, MAT, matrix, out_array, PACKED, slow_inputs,
                       status_error, strict_entry, VEC, vector, workspace,
                       wrench_mode)
@@ -122,7 +122,7 @@ def inverse_dynamics_derivatives(model, q, qd=None, qdd=None, wrench=None,
             and q.dtype is F64):    # lists, float32, link wrenches: below
         try:
             n = w.n
-            res = np.empty((2, n, n)) if out is None else out
+            res = EMPTY((2, n, n)) if out is None else out
             damping = w.zeros if drives is None else drive_slopes(
                 drives, w.zeros if qd is None else qd, w.scratch[2])
             if _dtau(model.packed, q, w.zeros if qd is None else qd,
@@ -164,7 +164,7 @@ def forward_dynamics_derivatives(model, q, qd, tau, wrench=None,
             and type(q) is ARRAY and q.dtype is F64):
         try:
             n = w.n
-            res = np.empty((3, n, n)) if out is None else out
+            res = EMPTY((3, n, n)) if out is None else out
             if _dqdd(model.packed, q, qd, tau,
                      w.zero_wrench if wrench is None else wrench, w.zeros,
                      w.zeros, flags, w.ws, w.cw, w.dw, w.chol, w.scratch,

@@ -77,7 +77,7 @@ from . import kernels as K
 from .batch import (coriolis_matrix_batch, forward_dynamics_batch,
                     gravity_torques_batch, inverse_dynamics_batch,
                     mass_matrix_batch)
-from .calling import (ARRAY, bad_method, BOOL, CORIOLIS_METHODS, F64,
+from .calling import (ARRAY, bad_method, BOOL, CORIOLIS_METHODS, EMPTY, F64,
                       FD_INPUTS, first_singular_pivot, foreign_workspace,
                       FORWARD_DYNAMICS_METHODS, INPUTS, inputs, INT,
                       MASS_MATRIX_METHODS, MAT, not_positive_definite,
@@ -178,7 +178,7 @@ def inverse_dynamics(model, q, qd=None, qdd=None, wrench=None,
         # lists, int arrays: converted at once, not tried first
         return _tau_converted(model, ws, q, qd, qdd, wrench, flags, out)
     try:
-        tau = np.empty(w.n) if out is None else out
+        tau = EMPTY(w.n) if out is None else out
         if _tau(model.packed, q, w.zeros if qd is None else qd,
                 w.zeros if qdd is None else qdd,
                 w.zero_wrench if wrench is None else wrench, flags, w.ws,
@@ -219,7 +219,7 @@ def _tau_converted(model, ws, q, qd, qdd, wrench, flags, out):
         and ws.nb == model.nb else workspace(model, ws))
     n = ws.n
     q, qd, qdd, wrench = inputs(ws, INPUTS, q, qd, qdd, wrench)
-    tau = np.empty(n) if out is None else out
+    tau = EMPTY(n) if out is None else out
     try:
         code = _tau(model.packed, q, qd, qdd, wrench, flags, ws.ws, tau)
     except TypeError:
@@ -263,7 +263,7 @@ def gravity_torques(model, q, *, ws=None, out=None):
             raise status_error(code, (q,))
         return tau
     try:
-        tau = np.empty(w.n) if out is None else out
+        tau = EMPTY(w.n) if out is None else out
         if _gravity(model.packed, q, w.ws, tau) < 0:
             return tau
     except (TypeError, AttributeError) as exc:
@@ -293,7 +293,7 @@ def mass_matrix(model, q, *, method='crba', ws=None, out=None):
         if type(q) is ARRAY:   # lists: below
             w = model.default_workspace if ws is None else ws
             try:
-                D = np.empty(w.square) if out is None else out
+                D = EMPTY(w.square) if out is None else out
                 if _crba(model.packed, q, w.ws, D) < 0:
                     return D
             except (TypeError, AttributeError) as exc:
@@ -347,7 +347,7 @@ def coriolis_matrix(model, q, qd, *, method='composite', ws=None, out=None):
     if type(q) is ARRAY:   # lists: below
         w = model.default_workspace if ws is None else ws
         try:
-            C = np.empty(w.square) if out is None else out
+            C = EMPTY(w.square) if out is None else out
             if _coriolis(model.packed, q, qd, composite, w.ws, w.cw,
                          w.scratch, C) < 0:
                 return C
@@ -400,7 +400,7 @@ def forward_dynamics(model, q, qd, tau, wrench=None, wrench_frame='base', *,
             return _aba_converted(model, ws, q, qd, tau, wrench,
                                   wrench_frame, flags, out)
         try:
-            qdd = np.empty(w.n) if out is None else out
+            qdd = EMPTY(w.n) if out is None else out
             if _aba(model.packed, q, qd, tau,
                     w.zero_wrench if wrench is None else wrench, flags,
                     w.ws, w.aw, qdd) < 0:

@@ -34,7 +34,7 @@ import math
 from numba import njit
 import numpy as np
 
-from ..calling import (ARRAY, BOOL, F64, F8, INT, MAT, out_array, PACKED,
+from ..calling import (ARRAY, BOOL, EMPTY, F64, F8, INT, MAT, out_array, PACKED,
                        slow_inputs, status_error, strict_entry, TARGET, VEC,
                        vector)
 from ..dynamics import jacobian
@@ -179,7 +179,7 @@ def _solved(entry, obs, q, r, out, *frame):
     code = None
     if (type(q) is ARRAY and q.dtype is F64
             and type(r) is ARRAY):     # lists: converted below
-        F = np.empty(6) if out is None else out
+        F = EMPTY(6) if out is None else out
         try:
             code = entry(obs._packed, q, r, obs.damping, *frame, obs.ws.ws,
                          obs.ws.frames, obs.J, obs._A, obs._y, F)
