@@ -92,7 +92,8 @@ def register(subparsers):
     obs.add_argument('--rest-thresholds', type=float, nargs='+',
                      default=[0.0], metavar='T', help='per joint (or one '
                      "for all), the rest reference's own tolerance: its "
-                     'tests use the larger of this and the threshold '
+                     'tests use the larger of this and the threshold, '
+                     "and test the joints' changes together too "
                      '(default 0: the threshold)')
     obs.add_argument('--static-friction', type=float, default=1.5,
                      metavar='R', help='at rest, allow for static friction '

@@ -25,6 +25,8 @@ position creeping beyond REST_TRAVEL, a stamp going backwards or a gap
 longer than EXPIRE ends the rest (a shorter one on the settled arm does
 not: a push begun in it is reported); a push under way when the rest
 value is taken is no contact after its release for longer than EXPIRE;
+with rest thresholds of its own, changes on several joints are a
+contact together, a joint that joins a contact expiring with it;
 and the thresholds suggested from a free recording cover the changes a
 settled residual shows.
 """
@@ -36,7 +38,8 @@ from newton_euler_ros.core.observer import (contact_step, initial_contact,
                                             ObserverRecording,
                                             suggest_thresholds)
 from newton_euler_ros.core.observer.contact import (CONFIRM, EXPIRE,
-                                                    REST_TRAVEL, SETTLE)
+                                                    REST_TRAVEL, SETTLE,
+                                                    TOGETHER_AFTER)
 import numpy as np
 import pytest
 
@@ -53,11 +56,12 @@ def model():
 
 
 def run(model, r, q=None, qd=None, t=None, rest_reference=True,
-        static=(9.0, 9.0)):
+        static=(9.0, 9.0), rest_thresholds=0.0):
     """Contact flags of a residual sequence r (m, 2), as the node steps."""
     obs = MomentumObserver(model, thresholds=THRESHOLDS,
                            static_friction=static,
-                           rest_reference=rest_reference)
+                           rest_reference=rest_reference,
+                           rest_thresholds=rest_thresholds)
     m = len(r)
     t = np.arange(m) * DT if t is None else t
     q = np.zeros((m, 2)) if q is None else q
@@ -153,6 +157,46 @@ def test_a_push_under_way_when_the_rest_value_is_taken(model):
     assert not out[t < 3.0].any()
     late = out[t > 3.0 + CONFIRM + EXPIRE + 2 * DT]
     assert not late.any() and c.count <= 1
+
+
+def test_changes_on_several_joints_are_a_contact_together(model):
+    # 0.8 of the threshold on both joints: neither alone, but the sum of
+    # their squares (1.28) is over 1; tested together only with rest
+    # thresholds of the observer's own, once the rest values have held
+    # for TOGETHER_AFTER
+    m = 400
+    r = pushed(m, 2.5, 0.8)
+    r[250:, 1] += 0.8
+    t, out, c = run(model, r, rest_thresholds=THRESHOLDS)
+    assert not out[t < 2.5].any()
+    first = t[np.argmax(out)]
+    assert out.any() and 2.5 + CONFIRM <= first <= 2.5 + CONFIRM + 2 * DT
+    assert c.rest.active.all() and c.count == 1
+    _, out, _ = run(model, r)               # each joint on its own: none
+    assert not out.any()
+    one = pushed(m, 2.5, 0.9)               # one joint: its own test only
+    _, out, _ = run(model, one, rest_thresholds=THRESHOLDS)
+    assert not out.any()
+    # the same changes soon after the arm settled (at SETTLE): not before
+    # the rest values have held for TOGETHER_AFTER (by then they have
+    # followed part of the change, as slow drift)
+    r = pushed(m, 1.0, 0.8)
+    r[100:, 1] += 0.8
+    t, out, _ = run(model, r, rest_thresholds=THRESHOLDS)
+    assert not out[t < SETTLE + TOGETHER_AFTER - 2 * DT].any()
+
+
+def test_a_joint_that_joins_a_contact_expires_with_it(model):
+    # joint 0 pushed by 2 N m from 2.5 s (its own test), joint 1 by 0.8
+    # from 2.7 s (the test together): both are the new rest values
+    # EXPIRE after joint 0's contact began, and nothing is reported after
+    m = 600
+    r = pushed(m, 2.5, 2.0)
+    r[270:, 1] += 0.8
+    t, out, c = run(model, r, rest_thresholds=THRESHOLDS)
+    assert out[(t > 2.5 + CONFIRM + 2 * DT) & (t < 2.5 + EXPIRE)].all()
+    assert not out[t > 2.5 + CONFIRM + EXPIRE + 2 * DT].any()
+    assert c.count == 1 and not c.rest.active.any()
 
 
 def test_thresholds_cover_what_a_settled_residual_shows(model):

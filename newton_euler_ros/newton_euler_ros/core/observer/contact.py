@@ -38,6 +38,23 @@ change that has held for ``EXPIRE`` seconds becomes the new rest value
 (a value taken while a small push was on would otherwise report its
 release as a contact for as long as the arm rests).
 
+The changes together (``together``: on when the observer has rest
+thresholds of its own, ``rest_thresholds``).  A push on the tool moves
+several joints at once; friction drifting at rest moves each on its
+own.  So the arm is also in contact when the sum over joints of
+``((r - b) / threshold)^2`` has exceeded 1 for ``CONFIRM`` seconds;
+the joints whose change exceeds ``TOGETHER_SHARE`` of their threshold
+are then in contact, and stay so while the sum exceeds 1 (or their own
+change the hysteresis), expiring with the contact they joined.  The
+suggested rest thresholds are four times the largest change of the
+free recording, so on it each change stays within a quarter of its
+threshold and the sum below n / 16.  Not before the
+rest values have held for ``TOGETHER_AFTER`` seconds, again after one
+expired: a push that went unreported and was still on when the arm
+settled leaves its release in them, which the sum would read as a
+contact.  With the thresholds themselves (a margin of 2) the sum could
+reach n / 4, so it is not tested then.
+
 Why the whole arm: friction settles at a stop and breaks away at a
 start, and both look like a push.  The joints of a move start and stop
 together, and the one that travels furthest shows it first: a joint
@@ -75,13 +92,19 @@ CONFIRM = 0.08
 EXPIRE = 1.5
 #: s, the time constant with which the rest value follows slow drift
 TRACK = 2.0
+#: the changes tested together: a joint takes part in the contact they
+#: report when its change exceeds this x its threshold
+TOGETHER_SHARE = 0.5
+#: s the rest values must have held before the changes are tested
+#: together (a value taken while a push was on has expired by then)
+TOGETHER_AFTER = EXPIRE
 
 # rows of RestState.rows (n columns)
 _CALM_SINCE, _LOW, _LO, _HI, _SUM, _COUNT, _B, _ABOVE, _SINCE, _DEV = \
     range(10)
 _ROWS = 10
 # entries of RestState.flags
-_RESTING, _ARMED, _T_PREV = 0, 1, 2
+_RESTING, _ARMED, _T_PREV, _TOGETHER_ABOVE, _ARMED_AT = 0, 1, 2, 3, 4
 
 
 class RestState:
@@ -92,7 +115,7 @@ class RestState:
         self.rows = np.zeros((_ROWS, n))
         self.anchor = np.zeros(n)
         self.active = np.zeros(n, dtype=np.bool_)
-        self.flags = np.array([0.0, 0.0, math.nan])
+        self.flags = np.array([0.0, 0.0, math.nan, math.nan, math.nan])
 
     @property
     def armed(self):
@@ -106,15 +129,15 @@ class RestState:
 
 
 @njit(**ENTRY)
-def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, band,
-               rows, anchor, active, flags):
+def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, together,
+               band, rows, anchor, active, flags):
     """
     One sample of the rest reference; True when a joint is in contact.
 
     ``band``: the threshold test's flags (no rest value is taken while
     one is set); ``measure``: take no contact (the rest values follow
     the residual throughout), to measure the deviations of a free
-    recording.
+    recording; ``together``: test the changes together as well.
     """
     n = r.shape[0]
     dt = t - flags[_T_PREV]
@@ -159,12 +182,34 @@ def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, band,
             settled &= t - rows[_CALM_SINCE, i] >= SETTLE
         if settled:
             flags[_ARMED] = 1.0
+            flags[_TOGETHER_ABOVE] = math.nan
+            flags[_ARMED_AT] = t
             for i in range(n):
                 rows[_B, i] = rows[_SUM, i] / rows[_COUNT, i]
                 rows[_ABOVE, i] = math.nan
         return False
     track = 1.0 - math.exp(-dt / TRACK)
     any_active = False
+    # the changes together: the sum of their squares, each over its
+    # threshold (joints with a threshold of 0 left out)
+    total = 0.0
+    for i in range(n):
+        if thr[i] > 0.0:
+            x = abs(r[i] - rows[_B, i]) / thr[i]
+            total += x * x
+    if total > 1.0:
+        if math.isnan(flags[_TOGETHER_ABOVE]):
+            flags[_TOGETHER_ABOVE] = t
+    else:
+        flags[_TOGETHER_ABOVE] = math.nan
+    together_on = (together and not measure
+                   and t - flags[_TOGETHER_ABOVE] >= CONFIRM
+                   and t - flags[_ARMED_AT] >= TOGETHER_AFTER)
+    together_hold = together and total > 1.0
+    episode = t     # when the contact under way began: joints join it
+    for i in range(n):
+        if active[i]:
+            episode = min(episode, rows[_SINCE, i])
     for i in range(n):
         d = abs(r[i] - rows[_B, i])
         rows[_DEV, i] = d
@@ -176,14 +221,21 @@ def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, band,
         if measure:
             pass
         elif active[i]:
-            active[i] = d > hysteresis * thr[i]
+            active[i] = d > hysteresis * thr[i] or (
+                together_hold and d > TOGETHER_SHARE * thr[i])
             if active[i] and t - rows[_SINCE, i] > EXPIRE:
                 active[i] = False           # the new rest value
                 rows[_B, i] = r[i]
                 rows[_ABOVE, i] = math.nan
-        elif t - rows[_ABOVE, i] >= CONFIRM:    # False when NaN
+                flags[_ARMED_AT] = t        # the test together waits
+                flags[_TOGETHER_ABOVE] = math.nan
+        elif t - rows[_ABOVE, i] >= CONFIRM or (        # False when NaN
+                together_on and d > TOGETHER_SHARE * thr[i]):
             active[i] = True
-            rows[_SINCE, i] = t
+            # by its own change: its own contact; by the test together
+            # only: it joins the contact under way, and expires with it
+            rows[_SINCE, i] = (t if t - rows[_ABOVE, i] >= CONFIRM
+                               else episode)
         if not active[i]:
             rows[_B, i] += track * (r[i] - rows[_B, i])
         any_active |= active[i]
@@ -191,14 +243,15 @@ def _rest_step(t, q, qd, r, thr, hysteresis, max_gap, measure, band,
 
 
 def rest_step(state, t, q, qd, r, thresholds, hysteresis, max_gap, band,
-              measure=False):
+              measure=False, together=False):
     """
     Advance ``state`` by one sample; return whether a joint is in contact.
 
-    ``band``: per joint, whether the threshold test reports contact.
+    ``band``: per joint, whether the threshold test reports contact;
+    ``together``: test the changes together as well (see above).
     """
     return bool(_rest_step(float(t), q, qd, r, thresholds, float(hysteresis),
-                           float(max_gap), measure, band, state.rows,
+                           float(max_gap), measure, together, band, state.rows,
                            state.anchor, state.active, state.flags))
 
 
@@ -299,13 +352,12 @@ def contact_step(obs, contact, r, allowance=None, t=None, q=None, qd=None):
             thr = state_thresholds(obs, contact.motion, contact.threshold)
     now = _contact(r, thr, obs.hysteresis, allowance, contact.active)
     if t is not None and obs.rest_reference and contact.rest is not None:
-        rest_thr = thr
-        if contact.rest_threshold is not None and \
-                obs.rest_thresholds.any():
-            rest_thr = np.maximum(thr, obs.rest_thresholds,
-                                  out=contact.rest_threshold)
+        own = contact.rest_threshold is not None and \
+            obs.rest_thresholds.any()
+        rest_thr = np.maximum(thr, obs.rest_thresholds,
+                              out=contact.rest_threshold) if own else thr
         now |= rest_step(contact.rest, t, q, qd, r, rest_thr, obs.hysteresis,
-                         obs.max_gap, contact.active)
+                         obs.max_gap, contact.active, together=own)
     if now and not contact.in_contact:
         contact.count += 1
     contact.in_contact = bool(now)
