@@ -36,6 +36,9 @@ FACTOR = 2.0
 #: longer than its stops): measured over 18 arms of the current-sensing
 #: example (docs/observer.md)
 REST_MARGIN = 2.0
+#: the intercept a of a + b s + c u is at least this x the joint's largest
+#: static friction allowance on the free recording
+BAND_SHARE = 0.05
 
 
 def beyond_friction(recording):
@@ -71,9 +74,14 @@ def suggest_state_thresholds(recording, factor=FACTOR):
     that is smallest on average over the recording's samples while
     lying above ``|r|`` beyond the static friction allowance at every
     one of them (a linear program per joint, ``a, b, c >= 0``), times
-    ``factor``, each rounded up to two digits.  ``a`` is at least the
-    rest reference's :func:`rest_changes` times ``factor`` (0.1 at
-    least), as :func:`suggest_thresholds`, run with these thresholds.
+    ``factor``, each rounded up to two digits.  ``a`` is at least
+    ``BAND_SHARE`` x the joint's largest static friction allowance (the
+    envelope needs no intercept where the allowance covers the free
+    recording's stops, but a held pose can hold friction nearer the
+    band's edge, which is itself an estimate: 1.5 x an identified
+    Coulomb friction), and at least the rest reference's
+    :func:`rest_changes` times ``factor`` (0.1 at least), as
+    :func:`suggest_thresholds`, run with these thresholds.
     With the recording at rest
     throughout, ``b = c = 0``.
     """
@@ -84,6 +92,11 @@ def suggest_state_thresholds(recording, factor=FACTOR):
         a[j], b[j], c[j] = _envelope(beyond[:, j], recording.speed[:, j],
                                      recording.acceleration[:, j])
     a = np.array([_round_up(factor * x) for x in a])
+    # the edge of the static friction band is an estimate: a resting
+    # joint may hold more than the free recording's stops did
+    band = np.max(recording.allowance, axis=0)
+    a = np.maximum(a, [_round_up(BAND_SHARE * x) if x > 0.0 else 0.0
+                       for x in band])
     b = np.array([_round_up(factor * x, 0.0) for x in b])
     c = np.array([_round_up(factor * x, 0.0) for x in c])
     # the rest reference's test and its calm test, with the thresholds
